@@ -1,0 +1,135 @@
+//! The assembly: the ordered, verified list of placements every exporter reads.
+//!
+//! An [`Assembly`] is the single plan that the LDraw, glTF, parts-list and
+//! booklet back ends trust. It is produced by the search and checked by the
+//! independent [`verify`] module before anything is written.
+
+pub mod verify;
+
+use serde::Serialize;
+
+use crate::catalog::{Color, PartKind};
+use crate::geom::{Cell, CellBox, Rot};
+
+/// A building step number, counted from 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct Step(pub u32);
+
+/// One piece placed in the grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub struct Placement {
+    /// Which part.
+    pub part: PartKind,
+    /// Minimum corner of the cells the piece fills.
+    pub origin: Cell,
+    /// Rotation about the vertical axis.
+    pub rot: Rot,
+}
+
+impl Placement {
+    /// A placement with its rotation made canonical for the part's symmetry.
+    pub fn new(part: PartKind, origin: Cell, rot: Rot) -> Self {
+        Placement {
+            part,
+            origin,
+            rot: part.spec().canonical_rot(rot),
+        }
+    }
+
+    /// The cells the piece fills, given the grid's plates per layer.
+    pub fn cells_box(&self, plates_per_layer: u8) -> CellBox {
+        let spec = self.part.spec();
+        let (sx, sy) = spec.footprint(self.rot);
+        CellBox {
+            min: self.origin,
+            sx,
+            sy,
+            sz: (spec.height_plates / plates_per_layer).max(1) as i32,
+        }
+    }
+}
+
+/// A placement with its place in the build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Placed {
+    /// Where and what.
+    pub placement: Placement,
+    /// The step that adds it.
+    pub step: Step,
+    /// Its colour.
+    pub color: Color,
+}
+
+/// The ordered build: pieces in the order a person adds them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Assembly {
+    /// Pieces in build order; steps never decrease.
+    pub pieces: Vec<Placed>,
+    /// Plates per voxel layer (3 for bricks).
+    pub plates_per_layer: u8,
+}
+
+impl Assembly {
+    /// An assembly from placements in build order, one step each.
+    pub fn from_order(order: &[Placement], plates_per_layer: u8, color: Color) -> Self {
+        Assembly {
+            pieces: order
+                .iter()
+                .enumerate()
+                .map(|(i, &placement)| Placed {
+                    placement,
+                    step: Step(i as u32 + 1),
+                    color,
+                })
+                .collect(),
+            plates_per_layer,
+        }
+    }
+
+    /// Number of steps (the highest step number).
+    pub fn step_count(&self) -> u32 {
+        self.pieces.last().map_or(0, |p| p.step.0)
+    }
+
+    /// Regroups the steps: `StepGrouping::Each` one piece a step,
+    /// `Size(n)` n pieces a step, `Layer` one step per layer run.
+    pub fn regroup(&mut self, grouping: StepGrouping) {
+        let mut step = 0u32;
+        let mut in_step = 0usize;
+        let mut last_z = i32::MIN;
+        for p in &mut self.pieces {
+            let new_step = match grouping {
+                StepGrouping::Each => true,
+                StepGrouping::Size(n) => in_step >= n.max(1),
+                StepGrouping::Layer => p.placement.origin.z != last_z,
+            };
+            if new_step || step == 0 {
+                step += 1;
+                in_step = 0;
+            }
+            in_step += 1;
+            last_z = p.placement.origin.z;
+            p.step = Step(step);
+        }
+    }
+
+    /// Pieces counted by part, in catalog order.
+    pub fn counts_by_part(&self) -> Vec<(PartKind, usize)> {
+        let mut counts = std::collections::BTreeMap::new();
+        for p in &self.pieces {
+            *counts.entry(p.placement.part).or_insert(0) += 1;
+        }
+        counts.into_iter().collect()
+    }
+}
+
+/// How pieces are grouped into steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum StepGrouping {
+    /// One piece a step (the default).
+    Each,
+    /// At most this many pieces a step.
+    Size(usize),
+    /// A new step whenever the build moves to another layer.
+    Layer,
+}

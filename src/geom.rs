@@ -1,0 +1,177 @@
+//! Integer grid geometry shared by every stage: cells, orientations, boxes.
+//!
+//! The voxel grid is right-handed with `x` and `y` horizontal (one stud each)
+//! and `z` vertical (one layer each, 1.2 studs for bricks). A piece's place is
+//! the minimum corner of its bounding box of cells plus its [`Rot`] about the
+//! vertical axis. LDraw's axes are derived from these in `export::ldraw`.
+
+use serde::Serialize;
+
+/// A voxel cell (or a piece's minimum corner) in grid coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct Cell {
+    /// Stud column along the grid's x axis.
+    pub x: i32,
+    /// Stud row along the grid's y axis.
+    pub y: i32,
+    /// Layer, counted upward from 0.
+    pub z: i32,
+}
+
+impl Cell {
+    /// A cell from its three coordinates.
+    pub const fn new(x: i32, y: i32, z: i32) -> Self {
+        Cell { x, y, z }
+    }
+
+    /// This cell moved by `(dx, dy, dz)`.
+    pub const fn offset(self, dx: i32, dy: i32, dz: i32) -> Self {
+        Cell::new(self.x + dx, self.y + dy, self.z + dz)
+    }
+}
+
+/// A quarter-turn rotation about the vertical axis, counter-clockwise seen
+/// from above.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum Rot {
+    /// The part as drawn in its library file.
+    R0,
+    /// A quarter turn.
+    R90,
+    /// A half turn.
+    R180,
+    /// Three quarter turns.
+    R270,
+}
+
+impl Rot {
+    /// All four rotations, in order.
+    pub const ALL: [Rot; 4] = [Rot::R0, Rot::R90, Rot::R180, Rot::R270];
+
+    /// The number of quarter turns.
+    pub const fn quarter_turns(self) -> u8 {
+        match self {
+            Rot::R0 => 0,
+            Rot::R90 => 1,
+            Rot::R180 => 2,
+            Rot::R270 => 3,
+        }
+    }
+
+    /// The rotation with `n` quarter turns (taken modulo 4).
+    pub const fn from_quarter_turns(n: u8) -> Rot {
+        match n % 4 {
+            0 => Rot::R0,
+            1 => Rot::R90,
+            2 => Rot::R180,
+            _ => Rot::R270,
+        }
+    }
+
+    /// This rotation followed by `other`.
+    pub const fn then(self, other: Rot) -> Rot {
+        Rot::from_quarter_turns(self.quarter_turns() + other.quarter_turns())
+    }
+
+    /// Whether the footprint's width and depth swap.
+    pub const fn swaps_axes(self) -> bool {
+        matches!(self, Rot::R90 | Rot::R270)
+    }
+
+    /// The rotation's angle in degrees.
+    pub const fn degrees(self) -> u16 {
+        self.quarter_turns() as u16 * 90
+    }
+
+    /// Parses `r0`, `r90`, `r180` or `r270`.
+    pub fn parse(s: &str) -> Option<Rot> {
+        match s {
+            "r0" => Some(Rot::R0),
+            "r90" => Some(Rot::R90),
+            "r180" => Some(Rot::R180),
+            "r270" => Some(Rot::R270),
+            _ => None,
+        }
+    }
+
+    /// The form [`Rot::parse`] reads.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Rot::R0 => "r0",
+            Rot::R90 => "r90",
+            Rot::R180 => "r180",
+            Rot::R270 => "r270",
+        }
+    }
+
+    /// Rotates the horizontal vector `(x, y)` by this rotation.
+    pub const fn apply(self, x: i32, y: i32) -> (i32, i32) {
+        match self {
+            Rot::R0 => (x, y),
+            Rot::R90 => (-y, x),
+            Rot::R180 => (-x, -y),
+            Rot::R270 => (y, -x),
+        }
+    }
+}
+
+/// An axis-aligned box of cells, `min` inclusive, `size` cells along each axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub struct CellBox {
+    /// The minimum corner.
+    pub min: Cell,
+    /// Extent along x, in cells (at least 1).
+    pub sx: i32,
+    /// Extent along y, in cells (at least 1).
+    pub sy: i32,
+    /// Extent along z, in cells (at least 1).
+    pub sz: i32,
+}
+
+impl CellBox {
+    /// The exclusive maximum corner.
+    pub const fn max_excl(&self) -> Cell {
+        self.min.offset(self.sx, self.sy, self.sz)
+    }
+
+    /// Number of cells in the box.
+    pub const fn volume(&self) -> i32 {
+        self.sx * self.sy * self.sz
+    }
+
+    /// Whether `c` lies inside the box.
+    pub const fn contains(&self, c: Cell) -> bool {
+        c.x >= self.min.x
+            && c.y >= self.min.y
+            && c.z >= self.min.z
+            && c.x < self.min.x + self.sx
+            && c.y < self.min.y + self.sy
+            && c.z < self.min.z + self.sz
+    }
+
+    /// Whether the two boxes share a cell.
+    pub const fn intersects(&self, o: &CellBox) -> bool {
+        self.min.x < o.min.x + o.sx
+            && o.min.x < self.min.x + self.sx
+            && self.min.y < o.min.y + o.sy
+            && o.min.y < self.min.y + self.sy
+            && self.min.z < o.min.z + o.sz
+            && o.min.z < self.min.z + self.sz
+    }
+
+    /// Whether the footprints (x, y) of the two boxes overlap.
+    pub const fn footprints_overlap(&self, o: &CellBox) -> bool {
+        self.min.x < o.min.x + o.sx
+            && o.min.x < self.min.x + self.sx
+            && self.min.y < o.min.y + o.sy
+            && o.min.y < self.min.y + self.sy
+    }
+
+    /// Every cell of the box, x fastest, then y, then z.
+    pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
+        let m = self.min;
+        (0..self.sz).flat_map(move |dz| {
+            (0..self.sy).flat_map(move |dy| (0..self.sx).map(move |dx| m.offset(dx, dy, dz)))
+        })
+    }
+}

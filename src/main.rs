@@ -1,0 +1,3 @@
+//! The `brickwright` command-line tool (being written).
+
+fn main() {}

@@ -1,0 +1,283 @@
+//! A dense bitset of voxels, one bit a cell, rows of 64-bit words.
+
+use crate::geom::{Cell, CellBox};
+
+/// A dense 3D bitset over `nx * ny * nz` cells; `x` is the fastest axis.
+///
+/// Each row of cells along x is padded to whole 64-bit words, so a run of
+/// cells along x is tested with a mask.
+#[derive(Clone, PartialEq, Eq)]
+pub struct VoxelGrid {
+    nx: i32,
+    ny: i32,
+    nz: i32,
+    words_per_row: usize,
+    bits: Vec<u64>,
+}
+
+impl std::fmt::Debug for VoxelGrid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "VoxelGrid({}x{}x{}, {} filled)",
+            self.nx,
+            self.ny,
+            self.nz,
+            self.count()
+        )
+    }
+}
+
+impl VoxelGrid {
+    /// An empty grid of the given size. Sizes below 1 are raised to 1.
+    pub fn new(nx: i32, ny: i32, nz: i32) -> Self {
+        let (nx, ny, nz) = (nx.max(1), ny.max(1), nz.max(1));
+        let words_per_row = (nx as usize).div_ceil(64);
+        VoxelGrid {
+            nx,
+            ny,
+            nz,
+            words_per_row,
+            bits: vec![0; words_per_row * ny as usize * nz as usize],
+        }
+    }
+
+    /// Size along x, y and z.
+    pub fn dims(&self) -> (i32, i32, i32) {
+        (self.nx, self.ny, self.nz)
+    }
+
+    /// Whether `c` lies inside the grid.
+    #[inline]
+    pub fn in_bounds(&self, c: Cell) -> bool {
+        c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < self.nx && c.y < self.ny && c.z < self.nz
+    }
+
+    #[inline]
+    fn row(&self, y: i32, z: i32) -> usize {
+        (z as usize * self.ny as usize + y as usize) * self.words_per_row
+    }
+
+    /// Whether `c` is filled; cells outside the grid are empty.
+    #[inline]
+    pub fn get(&self, c: Cell) -> bool {
+        if !self.in_bounds(c) {
+            return false;
+        }
+        let w = self.row(c.y, c.z) + (c.x as usize >> 6);
+        self.bits[w] >> (c.x & 63) & 1 == 1
+    }
+
+    /// Fills or clears `c`. Panics if `c` is outside the grid (a caller bug).
+    #[inline]
+    pub fn set(&mut self, c: Cell, on: bool) {
+        assert!(self.in_bounds(c), "cell {c:?} outside grid {self:?}");
+        let w = self.row(c.y, c.z) + (c.x as usize >> 6);
+        let m = 1u64 << (c.x & 63);
+        if on {
+            self.bits[w] |= m;
+        } else {
+            self.bits[w] &= !m;
+        }
+    }
+
+    /// Mask of the bits for cells `x0..x0+len` within one word, and the word.
+    #[inline]
+    fn run_words(&self, x0: i32, len: i32) -> impl Iterator<Item = (usize, u64)> {
+        let x1 = x0 + len; // exclusive
+        let first = x0 as usize >> 6;
+        let last = (x1 as usize - 1) >> 6;
+        (first..=last).map(move |w| {
+            let lo = if w == first { x0 as usize & 63 } else { 0 };
+            let hi = if w == last {
+                ((x1 as usize - 1) & 63) + 1
+            } else {
+                64
+            };
+            let mask = if hi - lo == 64 {
+                u64::MAX
+            } else {
+                ((1u64 << (hi - lo)) - 1) << lo
+            };
+            (w, mask)
+        })
+    }
+
+    /// Whether every cell of `b` is filled (false if `b` leaves the grid).
+    pub fn all_set(&self, b: &CellBox) -> bool {
+        let m = b.max_excl();
+        if b.min.x < 0
+            || b.min.y < 0
+            || b.min.z < 0
+            || m.x > self.nx
+            || m.y > self.ny
+            || m.z > self.nz
+        {
+            return false;
+        }
+        for z in b.min.z..m.z {
+            for y in b.min.y..m.y {
+                let r = self.row(y, z);
+                for (w, mask) in self.run_words(b.min.x, b.sx) {
+                    if self.bits[r + w] & mask != mask {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Whether any cell of `b` inside the grid is filled.
+    pub fn any_set(&self, b: &CellBox) -> bool {
+        let m = b.max_excl();
+        let (x0, y0, z0) = (b.min.x.max(0), b.min.y.max(0), b.min.z.max(0));
+        let (x1, y1, z1) = (m.x.min(self.nx), m.y.min(self.ny), m.z.min(self.nz));
+        if x0 >= x1 || y0 >= y1 || z0 >= z1 {
+            return false;
+        }
+        for z in z0..z1 {
+            for y in y0..y1 {
+                let r = self.row(y, z);
+                for (w, mask) in self.run_words(x0, x1 - x0) {
+                    if self.bits[r + w] & mask != 0 {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Fills or clears every cell of `b` (which must lie inside the grid).
+    pub fn set_box(&mut self, b: &CellBox, on: bool) {
+        let m = b.max_excl();
+        assert!(self.in_bounds(b.min) && self.in_bounds(m.offset(-1, -1, -1)));
+        for z in b.min.z..m.z {
+            for y in b.min.y..m.y {
+                let r = self.row(y, z);
+                let words: Vec<_> = self.run_words(b.min.x, b.sx).collect();
+                for (w, mask) in words {
+                    if on {
+                        self.bits[r + w] |= mask;
+                    } else {
+                        self.bits[r + w] &= !mask;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Number of filled cells.
+    pub fn count(&self) -> usize {
+        self.bits.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    /// Number of filled cells in layer `z`.
+    pub fn count_layer(&self, z: i32) -> usize {
+        if z < 0 || z >= self.nz {
+            return 0;
+        }
+        let n = self.words_per_row * self.ny as usize;
+        let s = z as usize * n;
+        self.bits[s..s + n]
+            .iter()
+            .map(|w| w.count_ones() as usize)
+            .sum()
+    }
+
+    /// Whether no cell is filled.
+    pub fn is_empty(&self) -> bool {
+        self.bits.iter().all(|&w| w == 0)
+    }
+
+    /// Filled cells of layer `z`, in raster order (x fastest).
+    pub fn layer_cells(&self, z: i32) -> impl Iterator<Item = Cell> + '_ {
+        let wpr = self.words_per_row;
+        let rows = if z >= 0 && z < self.nz { self.ny } else { 0 };
+        (0..rows).flat_map(move |y| {
+            let r = self.row(y, z);
+            (0..wpr).flat_map(move |w| {
+                let mut word = self.bits[r + w];
+                std::iter::from_fn(move || {
+                    if word == 0 {
+                        return None;
+                    }
+                    let b = word.trailing_zeros();
+                    word &= word - 1;
+                    Some(Cell::new((w as i32) * 64 + b as i32, y, z))
+                })
+            })
+        })
+    }
+
+    /// Every filled cell, layer by layer from the bottom, raster order within.
+    pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
+        (0..self.nz).flat_map(move |z| self.layer_cells(z))
+    }
+
+    /// The smallest box holding every filled cell, or `None` if empty.
+    pub fn bounds(&self) -> Option<CellBox> {
+        let mut lo = Cell::new(i32::MAX, i32::MAX, i32::MAX);
+        let mut hi = Cell::new(i32::MIN, i32::MIN, i32::MIN);
+        for c in self.cells() {
+            lo = Cell::new(lo.x.min(c.x), lo.y.min(c.y), lo.z.min(c.z));
+            hi = Cell::new(hi.x.max(c.x), hi.y.max(c.y), hi.z.max(c.z));
+        }
+        (lo.x <= hi.x).then(|| CellBox {
+            min: lo,
+            sx: hi.x - lo.x + 1,
+            sy: hi.y - lo.y + 1,
+            sz: hi.z - lo.z + 1,
+        })
+    }
+
+    /// Linear index of an in-bounds cell (x fastest), for side tables.
+    #[inline]
+    pub fn index(&self, c: Cell) -> usize {
+        (c.z as usize * self.ny as usize + c.y as usize) * self.nx as usize + c.x as usize
+    }
+
+    /// Number of cells in the grid, filled or not.
+    pub fn len(&self) -> usize {
+        self.nx as usize * self.ny as usize * self.nz as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn set_get_and_boxes_across_word_boundaries() {
+        let mut g = VoxelGrid::new(130, 3, 2);
+        let b = CellBox {
+            min: Cell::new(60, 1, 0),
+            sx: 70,
+            sy: 2,
+            sz: 2,
+        };
+        g.set_box(&b, true);
+        assert_eq!(g.count(), 70 * 2 * 2);
+        assert!(g.all_set(&b));
+        assert!(g.get(Cell::new(63, 1, 1)) && g.get(Cell::new(64, 2, 0)));
+        assert!(!g.get(Cell::new(59, 1, 0)));
+        let inner = CellBox {
+            min: Cell::new(100, 1, 1),
+            sx: 3,
+            sy: 1,
+            sz: 1,
+        };
+        g.set_box(&inner, false);
+        assert!(!g.all_set(&b));
+        assert!(g.any_set(&b));
+        assert_eq!(g.layer_cells(1).count(), 70 * 2 - 3);
+        assert_eq!(g.bounds().unwrap(), b);
+        assert!(!g.any_set(&CellBox {
+            min: Cell::new(0, 0, 0),
+            sx: 60,
+            sy: 3,
+            sz: 2
+        }));
+    }
+}

@@ -1,0 +1,8 @@
+//! Voxels: the solid, quantized shape the search builds.
+//!
+//! One voxel is 1 x 1 x 1.2 (a stud by a brick's height).
+
+mod grid;
+pub mod voxelize;
+
+pub use grid::VoxelGrid;
