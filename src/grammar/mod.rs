@@ -1,1 +1,345 @@
-//! (being written)
+//! The Lego rewriting system (Σ, R) of Lau's paper, section 3.
+//!
+//! Σ, the alphabet, is a set of piece types from the [catalog](crate::catalog).
+//! R is a set of rewriting rules `u -> v`:
+//!
+//! - a **starting rule** `ε -> P` puts a first piece `P` down;
+//! - a **basic-form rule** `A -> A + B` adds a piece `B` stud-connected to an
+//!   existing piece `A`, either on top of it (`up`) or underneath (`down`),
+//!   at an offset and a rotation relative to `A`.
+//!
+//! Each rule carries a weight: how often people use it. The search samples
+//! rules from the categorical distribution of these weights, so common,
+//! sturdy joints are tried first.
+//!
+//! Rules are read from human-readable files ([`RuleSet::parse`]); the file
+//! gives each rule once, with `A` unturned, and the loader generates the
+//! rotations about the vertical axis once (paper, section 4), merging the
+//! copies a symmetric part makes identical.
+//!
+//! ```
+//! use brickwright::grammar::RuleSet;
+//! let text = "part 3003\nstart 3003\nrule 3003 3003 r0 up 1 0 5\n";
+//! let rules = RuleSet::parse(text, "inline.rules".as_ref()).unwrap();
+//! assert_eq!(rules.alphabet().len(), 1);
+//! // A 2x2 half-overlapping a 2x2 looks the same turned by a half turn
+//! // only after a shift, so all four quarter turns are distinct rules.
+//! assert_eq!(rules.variants().len(), 4);
+//! ```
+
+mod defaults;
+mod parse;
+
+pub use defaults::{default_rules_text, extended_alphabet, rules_text, DEFAULT_ALPHABET};
+pub use parse::RuleError;
+
+use serde::Serialize;
+
+use crate::catalog::PartKind;
+use crate::geom::{Cell, CellBox, Rot};
+
+/// Which side of its anchor a rule's new piece goes on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum Dir {
+    /// The new piece is pressed on top of the anchor.
+    Up,
+    /// The new piece is pressed onto the anchor from below.
+    Down,
+}
+
+impl Dir {
+    /// `up` or `down`, as in rule files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dir::Up => "up",
+            Dir::Down => "down",
+        }
+    }
+}
+
+/// Index of a rule as written in the file (0-based, in file order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct RuleId(pub u32);
+
+/// A basic-form rule `A -> A + B` as written: `A` unturned at the origin.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Rule {
+    /// The existing piece `A`.
+    pub anchor: PartKind,
+    /// The new piece `B`.
+    pub added: PartKind,
+    /// `B`'s rotation relative to `A`.
+    pub added_rot: Rot,
+    /// Whether `B` goes on top of `A` or underneath.
+    pub dir: Dir,
+    /// Offset of `B`'s minimum corner from `A`'s, in studs.
+    pub dx: i32,
+    /// Offset of `B`'s minimum corner from `A`'s, in studs.
+    pub dy: i32,
+    /// How often people use the rule (any positive number).
+    pub weight: f64,
+    /// The line of the rule file that defines it.
+    pub line: usize,
+}
+
+/// A starting rule `ε -> P`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StartRule {
+    /// The piece put down.
+    pub part: PartKind,
+    /// The line of the rule file that defines it.
+    pub line: usize,
+}
+
+/// A rule turned about the vertical axis and resolved to cell offsets: what
+/// the search matches.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Variant {
+    /// The rule it was generated from.
+    pub rule: RuleId,
+    /// The anchor's part.
+    pub anchor: PartKind,
+    /// The anchor's rotation (canonical for its symmetry).
+    pub anchor_rot: Rot,
+    /// The new piece's part.
+    pub added: PartKind,
+    /// The new piece's rotation (canonical for its symmetry).
+    pub added_rot: Rot,
+    /// Offset of the new piece's minimum corner from the anchor's, in cells.
+    pub offset: (i32, i32, i32),
+    /// Up or down.
+    pub dir: Dir,
+    /// The rule's weight shared among its distinct rotations.
+    pub weight: f64,
+}
+
+/// The rewriting system: the alphabet, the starting rules, the basic rules
+/// and their rotated variants.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleSet {
+    alphabet: Vec<PartKind>,
+    starts: Vec<StartRule>,
+    rules: Vec<Rule>,
+    variants: Vec<Variant>,
+    /// Where the rules came from, for reports.
+    pub source: String,
+}
+
+/// Plates per layer of the voxel grids this rule set builds (bricks only).
+pub const PLATES_PER_LAYER: u8 = 3;
+
+/// The cells of `part` turned by `rot` with its minimum corner at `at`.
+pub fn piece_box(part: PartKind, rot: Rot, at: Cell) -> CellBox {
+    let spec = part.spec();
+    let (sx, sy) = spec.footprint(rot);
+    CellBox {
+        min: at,
+        sx,
+        sy,
+        sz: (spec.height_plates / PLATES_PER_LAYER).max(1) as i32,
+    }
+}
+
+impl RuleSet {
+    /// Builds a rule set from its parts, generating rotated variants.
+    ///
+    /// Errors if a rule names a part outside the alphabet or does not
+    /// connect its two pieces; `source` names the file in messages.
+    pub fn new(
+        alphabet: Vec<PartKind>,
+        starts: Vec<StartRule>,
+        rules: Vec<Rule>,
+        source: String,
+    ) -> Result<RuleSet, RuleError> {
+        let mut set = RuleSet { alphabet, starts, rules, variants: Vec::new(), source };
+        set.variants = set.generate_variants()?;
+        Ok(set)
+    }
+
+    /// The letters of Σ.
+    pub fn alphabet(&self) -> &[PartKind] {
+        &self.alphabet
+    }
+
+    /// The starting rules.
+    pub fn starts(&self) -> &[StartRule] {
+        &self.starts
+    }
+
+    /// The basic-form rules, as written.
+    pub fn rules(&self) -> &[Rule] {
+        &self.rules
+    }
+
+    /// Every rotation of every basic rule.
+    pub fn variants(&self) -> &[Variant] {
+        &self.variants
+    }
+
+    /// Whether `part` has a starting rule.
+    pub fn can_start(&self, part: PartKind) -> bool {
+        self.starts.iter().any(|s| s.part == part)
+    }
+
+    fn generate_variants(&self) -> Result<Vec<Variant>, RuleError> {
+        let mut out: Vec<Variant> = Vec::new();
+        for (i, r) in self.rules.iter().enumerate() {
+            for part in [r.anchor, r.added] {
+                if !self.alphabet.contains(&part) {
+                    return Err(RuleError::at(
+                        &self.source,
+                        r.line,
+                        format!("part {part} is not in the alphabet; add a `part {part}` line"),
+                    ));
+                }
+            }
+            let a = piece_box(r.anchor, Rot::R0, Cell::new(0, 0, 0));
+            let b0 = piece_box(r.added, r.added_rot, Cell::new(r.dx, r.dy, 0));
+            if !a.footprints_overlap(&b0) {
+                return Err(RuleError::at(
+                    &self.source,
+                    r.line,
+                    format!(
+                        "the new {} at offset ({}, {}) does not overlap the {} below or above it, so no stud connects them",
+                        r.added, r.dx, r.dy, r.anchor
+                    ),
+                ));
+            }
+            let mut mine: Vec<Variant> = Vec::new();
+            for turn in Rot::ALL {
+                let ra = turn_box(&a, turn);
+                let rb = turn_box(&b0, turn);
+                let dz = match r.dir {
+                    Dir::Up => a.sz,
+                    Dir::Down => -b0.sz,
+                };
+                let v = Variant {
+                    rule: RuleId(i as u32),
+                    anchor: r.anchor,
+                    anchor_rot: r.anchor.spec().canonical_rot(turn),
+                    added: r.added,
+                    added_rot: r.added.spec().canonical_rot(r.added_rot.then(turn)),
+                    offset: (rb.min.x - ra.min.x, rb.min.y - ra.min.y, dz),
+                    dir: r.dir,
+                    weight: 0.0,
+                };
+                if !mine.iter().any(|m| same_geometry(m, &v)) {
+                    mine.push(v);
+                }
+            }
+            let n = mine.len() as f64;
+            for mut v in mine {
+                v.weight = r.weight / n;
+                out.push(v);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Writes the rule set back as a rule file that [`RuleSet::parse`]
+    /// reads to an equal rule set.
+    pub fn to_text(&self, header: &str) -> String {
+        let mut s = String::new();
+        for line in header.lines() {
+            s.push_str("# ");
+            s.push_str(line);
+            s.push('\n');
+        }
+        s.push('\n');
+        for p in &self.alphabet {
+            s.push_str(&format!("part {:<6} # {}\n", p.to_string(), p.spec().name));
+        }
+        s.push('\n');
+        for st in &self.starts {
+            s.push_str(&format!("start {}\n", st.part));
+        }
+        s.push_str("\n#    anchor new    rot  dir   dx  dy  weight\n");
+        for r in &self.rules {
+            s.push_str(&format!(
+                "rule {:<6} {:<6} {:<4} {:<5} {:>3} {:>3}  {}\n",
+                r.anchor.to_string(),
+                r.added.to_string(),
+                r.added_rot.name(),
+                r.dir.name(),
+                r.dx,
+                r.dy,
+                fmt_weight(r.weight)
+            ));
+        }
+        s
+    }
+}
+
+/// A weight as rule files write it: no trailing zeros.
+fn fmt_weight(w: f64) -> String {
+    let s = format!("{w:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+fn same_geometry(a: &Variant, b: &Variant) -> bool {
+    a.anchor == b.anchor
+        && a.anchor_rot == b.anchor_rot
+        && a.added == b.added
+        && a.added_rot == b.added_rot
+        && a.offset == b.offset
+        && a.dir == b.dir
+}
+
+/// Turns a box about the vertical axis through the origin (cell corners).
+fn turn_box(b: &CellBox, turn: Rot) -> CellBox {
+    let (x0, y0) = (b.min.x, b.min.y);
+    let (x1, y1) = (b.min.x + b.sx, b.min.y + b.sy);
+    let (ax, ay) = turn.apply(x0, y0);
+    let (bx, by) = turn.apply(x1, y1);
+    CellBox {
+        min: Cell::new(ax.min(bx), ay.min(by), b.min.z),
+        sx: (ax - bx).abs(),
+        sy: (ay - by).abs(),
+        sz: b.sz,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kind(id: &str) -> PartKind {
+        PartKind::from_id(id).unwrap()
+    }
+
+    #[test]
+    fn rotations_are_generated_and_symmetric_copies_merged() {
+        // A 2x2 centred on a 2x2: every turn gives the same rule.
+        let text = "part 3003\nstart 3003\nrule 3003 3003 r0 up 0 0 4\n";
+        let rs = RuleSet::parse(text, "t.rules".as_ref()).unwrap();
+        assert_eq!(rs.variants().len(), 1);
+        assert_eq!(rs.variants()[0].weight, 4.0);
+        // A 1x2 across the end of a 2x4: four distinct turns.
+        let text = "part 3001\npart 3004\nrule 3001 3004 r90 up 3 0 8\n";
+        let rs = RuleSet::parse(text, "t.rules".as_ref()).unwrap();
+        let v = rs.variants();
+        assert_eq!(v.len(), 4);
+        assert!(v.iter().all(|v| (v.weight - 2.0).abs() < 1e-12));
+        // Turned a quarter, the 2x4 stands along y and the 1x2 along x.
+        let q = v.iter().find(|v| v.anchor_rot == Rot::R90 && v.offset.1 == 3).unwrap();
+        assert_eq!(q.added_rot, Rot::R0);
+        assert_eq!(q.offset, (0, 3, 1));
+        assert_eq!(q.anchor, kind("3001"));
+    }
+
+    #[test]
+    fn every_variant_connects_its_pieces() {
+        let rs = RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap();
+        for v in rs.variants() {
+            let a = piece_box(v.anchor, v.anchor_rot, Cell::new(0, 0, 0));
+            let (dx, dy, dz) = v.offset;
+            let b = piece_box(v.added, v.added_rot, Cell::new(dx, dy, dz));
+            assert!(a.footprints_overlap(&b), "{v:?}");
+            match v.dir {
+                Dir::Up => assert_eq!(b.min.z, a.min.z + a.sz),
+                Dir::Down => assert_eq!(b.min.z + b.sz, a.min.z),
+            }
+        }
+    }
+}

@@ -1,1 +1,342 @@
-//! (being written)
+//! Structural analysis: the backward tracing of the rewriting rules
+//! (paper, section 4), with the hierarchical split at horizontal planes.
+//!
+//! [`build`] takes the voxels and a [`RuleSet`] and returns the pieces in
+//! build order. It first repairs what no build can hold (floating islands),
+//! cuts the voxels at horizontal planes where the voxel count changes
+//! sharply, and traces each part backward in [`dfs`], bottom part first: a
+//! part's pieces may rest on the parts built before it. Every part's trace,
+//! replayed forward, adds each piece connected to one before it.
+
+mod dfs;
+mod grow;
+mod hierarchy;
+mod state;
+
+use std::time::{Duration, Instant};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use thiserror::Error;
+
+pub use state::{Anchor, Removal};
+
+use crate::assembly::Placement;
+use crate::grammar::RuleSet;
+use crate::voxel::VoxelGrid;
+use dfs::{PartResult, PartSearch};
+pub use hierarchy::{split_parts, Repairs};
+
+/// Tuning of the search. Defaults follow the paper where it gives numbers.
+#[derive(Debug, Clone, Serialize)]
+pub struct SearchOptions {
+    /// Seed of the random rule sampling. Default 1.
+    pub seed: u64,
+    /// Branching factor at the start of a part (paper: 10-30). Default 16.
+    pub b_min: usize,
+    /// Branching factor as the voxels left go to zero (paper: 100-200).
+    /// Default 160.
+    pub b_max: usize,
+    /// Nodes one attempt at a part may expand before it restarts. Default 200,000.
+    pub max_nodes_per_part: u64,
+    /// Restarts of a part, with fresh samples, before parts are merged. Default 3.
+    pub restarts: u32,
+    /// Layers a part may have before the hierarchy cuts it anyway. Default 6.
+    pub max_part_layers: i32,
+    /// Wall-clock budget for the whole search. Default 120 s.
+    pub time_budget: Duration,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        SearchOptions {
+            seed: 1,
+            b_min: 16,
+            b_max: 160,
+            max_nodes_per_part: 200_000,
+            restarts: 3,
+            max_part_layers: 6,
+            time_budget: Duration::from_secs(120),
+        }
+    }
+}
+
+impl SearchOptions {
+    /// Sets the seed.
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Sets the time budget.
+    pub fn with_time_budget(mut self, t: Duration) -> Self {
+        self.time_budget = t;
+        self
+    }
+}
+
+/// What the search did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SearchStats {
+    /// Tree nodes expanded (reverse rule applications kept).
+    pub nodes: u64,
+    /// Nodes abandoned after their subtree failed.
+    pub backtracks: u64,
+    /// Structural matches looked at.
+    pub match_tries: u64,
+    /// Matches refused by the flood-fill placeability check.
+    pub rejected_placeable: u64,
+    /// Matches refused because the rest would fall apart.
+    pub rejected_connect: u64,
+    /// Matches refused because a voxel left could no longer join the build.
+    pub rejected_reach: u64,
+    /// Deepest path.
+    pub max_depth: u64,
+    /// Starting rules applied.
+    pub starts: u64,
+    /// Part attempts restarted after running out of nodes.
+    pub restarts: u64,
+    /// Parts merged with the part above after failing.
+    pub merges: u64,
+    /// Nodes whose sampled rules found nothing, widened to every rule.
+    pub widened: u64,
+    /// Parts the hierarchy cut the model into (after merges).
+    pub parts: u64,
+}
+
+
+/// A search that could not produce a build.
+#[derive(Debug, Error)]
+pub enum SearchError {
+    /// No voxels to build.
+    #[error("nothing to build: the voxel model is empty")]
+    Empty,
+    /// Budgets ran out.
+    #[error("the search ran out of its budget ({nodes} nodes, {secs:.1} s) with {left} of {total} voxels unbuilt; try another --seed or a smaller size")]
+    Budget {
+        /// Nodes expanded.
+        nodes: u64,
+        /// Seconds spent.
+        secs: f64,
+        /// Voxels left.
+        left: usize,
+        /// Voxels in all.
+        total: usize,
+    },
+}
+
+/// The result of [`build`].
+#[derive(Debug, Clone)]
+pub struct SearchOutcome {
+    /// Pieces in build order, each with what it attaches to.
+    pub order: Vec<Removal>,
+    /// The voxels actually built (the input after repairs).
+    pub voxels: VoxelGrid,
+    /// What the repairs changed.
+    pub repairs: Repairs,
+    /// Counters.
+    pub stats: SearchStats,
+}
+
+/// Finds an ordered, connected build of `voxels` with the rules `rules`.
+pub fn build(voxels: &VoxelGrid, rules: &RuleSet, opts: &SearchOptions) -> Result<SearchOutcome, SearchError> {
+    if voxels.is_empty() {
+        return Err(SearchError::Empty);
+    }
+    let started = Instant::now();
+    let deadline = started + opts.time_budget;
+    let (fixed, repairs) = hierarchy::repair_islands(voxels);
+    let mut parts = split_parts(&fixed, opts.max_part_layers);
+    let mut stats = SearchStats::default();
+    let (nx, ny, nz) = fixed.dims();
+    let mut built = VoxelGrid::new(nx, ny, nz);
+    let mut order: Vec<Removal> = Vec::new();
+    let search = PartSearch::new(rules, opts, deadline);
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let mut i = 0;
+    while i < parts.len() {
+        let mut done = None;
+        for attempt in 0..=opts.restarts {
+            if attempt > 0 {
+                stats.restarts += 1;
+            }
+            let result = if built.is_empty() {
+                grow::grow(&parts[i], rules, opts, deadline, &mut rng, &mut stats)
+            } else {
+                search.run(parts[i].clone(), &built, &mut rng, &mut stats)
+            };
+            match result {
+                PartResult::Built(trace) => {
+                    done = Some(trace);
+                    break;
+                }
+                PartResult::Unbuildable => break,
+                PartResult::OutOfBudget => {
+                    if Instant::now() >= deadline {
+                        break;
+                    }
+                }
+            }
+        }
+        match done {
+            Some(trace) => {
+                for r in trace.iter().rev() {
+                    built.set_box(&r.piece.cells_box(crate::grammar::PLATES_PER_LAYER), true);
+                    order.push(*r);
+                }
+                i += 1;
+            }
+            None if i + 1 < parts.len() && Instant::now() < deadline => {
+                let next = parts.remove(i + 1);
+                merge_into(&mut parts[i], &next);
+                stats.merges += 1;
+            }
+            None => {
+                let left = parts[i..].iter().map(|p| p.count()).sum();
+                return Err(SearchError::Budget {
+                    nodes: stats.nodes,
+                    secs: started.elapsed().as_secs_f64(),
+                    left,
+                    total: fixed.count(),
+                });
+            }
+        }
+    }
+    stats.parts = parts.len() as u64;
+    Ok(SearchOutcome { order, voxels: fixed, repairs, stats })
+}
+
+fn merge_into(a: &mut VoxelGrid, b: &VoxelGrid) {
+    for c in b.cells().collect::<Vec<_>>() {
+        a.set(c, true);
+    }
+}
+
+/// The pieces of an outcome in build order.
+pub fn placements(outcome: &SearchOutcome) -> Vec<Placement> {
+    outcome.order.iter().map(|r| r.piece).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Cell, CellBox};
+    use crate::grammar::{default_rules_text, PLATES_PER_LAYER};
+
+    fn rules() -> RuleSet {
+        RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap()
+    }
+
+    fn grid(dims: (i32, i32, i32), boxes: &[CellBox]) -> VoxelGrid {
+        let mut g = VoxelGrid::new(dims.0, dims.1, dims.2);
+        for b in boxes {
+            g.set_box(b, true);
+        }
+        g
+    }
+
+    fn bx(x: i32, y: i32, z: i32, sx: i32, sy: i32, sz: i32) -> CellBox {
+        CellBox { min: Cell::new(x, y, z), sx, sy, sz }
+    }
+
+    /// Cover, no overlap, each piece connected to an earlier one.
+    fn check(out: &SearchOutcome) {
+        let (nx, ny, nz) = out.voxels.dims();
+        let mut seen = VoxelGrid::new(nx, ny, nz);
+        let boxes: Vec<CellBox> = out.order.iter().map(|r| r.piece.cells_box(PLATES_PER_LAYER)).collect();
+        for (i, b) in boxes.iter().enumerate() {
+            assert!(!seen.any_set(b), "piece {i} overlaps");
+            seen.set_box(b, true);
+            if i > 0 {
+                let ok = boxes[..i].iter().any(|a| {
+                    a.footprints_overlap(b) && (a.min.z + a.sz == b.min.z || b.min.z + b.sz == a.min.z)
+                });
+                assert!(ok, "piece {i} {:?} not connected to an earlier one", out.order[i]);
+            }
+        }
+        assert_eq!(seen, out.voxels);
+    }
+
+    fn run(g: &VoxelGrid) -> SearchOutcome {
+        let out = build(g, &rules(), &SearchOptions::default().with_time_budget(Duration::from_secs(20))).unwrap();
+        eprintln!("{} pieces {:?}", out.order.len(), out.stats);
+        check(&out);
+        out
+    }
+
+    #[test]
+    fn solid_box() {
+        let out = run(&grid((8, 6, 4), &[bx(0, 0, 0, 8, 6, 4)]));
+        assert!(out.repairs.is_empty());
+        assert!(out.order.len() < 8 * 6 * 4 / 3, "{} pieces", out.order.len());
+    }
+
+    #[test]
+    fn arch_needs_pieces_added_from_below() {
+        // The span is two layers thick, so staggered bricks can cross the gap.
+        let g = grid((10, 2, 6), &[bx(0, 0, 0, 2, 2, 4), bx(8, 0, 0, 2, 2, 4), bx(0, 0, 4, 10, 2, 2)]);
+        let out = run(&g);
+        assert!(out.order.iter().any(|r| matches!(r.anchor, Anchor::Piece(a) if a.origin.z > r.piece.origin.z)));
+    }
+
+    #[test]
+    fn towers_on_a_base_and_an_island() {
+        let g = grid(
+            (12, 12, 12),
+            &[bx(0, 0, 0, 12, 12, 2), bx(1, 1, 2, 3, 3, 6), bx(7, 6, 2, 4, 5, 4), bx(6, 0, 9, 3, 3, 2)],
+        );
+        let out = run(&g);
+        assert_eq!(out.repairs.supported_islands, 1);
+    }
+
+    #[test]
+    fn same_seed_same_build() {
+        let g = grid((9, 7, 5), &[bx(0, 0, 0, 9, 7, 3), bx(2, 2, 3, 5, 3, 2)]);
+        let a = run(&g);
+        let b = run(&g);
+        assert_eq!(placements(&a), placements(&b));
+        let c = build(&g, &rules(), &SearchOptions::default().with_seed(7)).unwrap();
+        check(&c);
+    }
+}
+#[cfg(test)]
+mod debug_tests {
+    use super::*;
+    use crate::geom::{Cell, CellBox};
+    use crate::grammar::default_rules_text;
+    #[test]
+    fn grounded_debug() {
+        let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
+        for (sx, sy, sz) in [(8, 6, 4), (12, 10, 6), (20, 16, 6), (30, 24, 6)] {
+            let mut g = VoxelGrid::new(sx, sy, sz + 2);
+            g.set_box(&CellBox { min: Cell::new(0, 0, 2), sx, sy, sz }, true);
+            let mut built = VoxelGrid::new(sx, sy, sz + 2);
+            built.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(5));
+            o.restarts = 0;
+            let search = PartSearch::new(&rules, &o, Instant::now() + o.time_budget);
+            let mut stats = SearchStats::default();
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let t = Instant::now();
+            let r = search.run(g, &built, &mut rng, &mut stats);
+            let what = match r { PartResult::Built(t) => format!("built {}", t.len()), PartResult::Unbuildable => "unbuildable".into(), PartResult::OutOfBudget => "budget".into() };
+            eprintln!("grounded {sx}x{sy}x{sz}: {what} in {:?} {stats:?}", t.elapsed());
+        }
+    }
+    #[test]
+    fn tiny_debug() {
+        let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
+        for (sx, sy, sz) in [(2, 2, 2), (4, 2, 2), (4, 4, 2), (6, 4, 2), (8, 6, 2), (12, 10, 2), (20, 16, 2), (6, 4, 3), (30, 24, 2), (48, 40, 2)] {
+            let mut g = VoxelGrid::new(sx, sy, sz);
+            g.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz }, true);
+            let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(3));
+            o.restarts = 0;
+            let mut stats = SearchStats::default();
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let r = grow::grow(&g, &rules, &o, Instant::now() + o.time_budget, &mut rng, &mut stats);
+            let what = match r { PartResult::Built(t) => format!("built {}", t.len()), PartResult::Unbuildable => "unbuildable".into(), PartResult::OutOfBudget => "budget".into() };
+            eprintln!("{sx}x{sy}x{sz}: {what} {stats:?}");
+        }
+    }
+}

@@ -1,0 +1,472 @@
+//! Backward tracing for one part: depth-first, rules applied in reverse.
+//!
+//! Each node samples `b` rules from the categorical distribution of the
+//! rules' weights (`b` grows as the voxels left go to zero), then scans the
+//! grid for matches lazily, in each rule's direction: rules that add a piece
+//! on top (`up`) match from the top layer down, rules that add a piece
+//! underneath (`down`) from the bottom layer up. A match must connect to the
+//! pieces matched so far (the first match excepted; a match that does not is
+//! only tried once no connected match is left), must leave a piece that can
+//! be pressed into place (the flood-fill check), and must leave voxels that
+//! can still form one connected build. A node with no applicable rule is
+//! backtracked. Starting rules are always tried: when the voxels left are
+//! exactly one piece, or a piece rests on the structure built before.
+
+use std::time::Instant;
+
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use super::state::{boxed, Anchor, Removal, State};
+use super::{SearchOptions, SearchStats};
+use crate::assembly::Placement;
+use crate::catalog::PartKind;
+use crate::geom::{Cell, CellBox, Rot};
+use crate::grammar::{Dir, RuleSet};
+use crate::voxel::VoxelGrid;
+
+/// What one node may try at a cell.
+#[derive(Debug, Clone, Copy)]
+enum Slot {
+    /// A basic rule's rotated variant, by index.
+    Rule(u32),
+    /// A starting rule's piece resting on the built structure.
+    OnBuilt(PartKind, Rot),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Scanning top-down for up rules and pieces on the built structure
+    /// (with nothing built: up and down rules together, outside in).
+    Up,
+    /// Scanning bottom-up for down rules.
+    Down,
+    /// Matches that do not touch the matched pieces, held back.
+    Deferred,
+    Done,
+}
+
+struct Frame {
+    /// The change that led here from the parent (None at the root).
+    applied: Option<Removal>,
+    up: Vec<Slot>,
+    down: Vec<Slot>,
+    phase: Phase,
+    /// Scan position: index into the phase's cell order, and the slot.
+    pos: usize,
+    slot: usize,
+    deferred: Vec<Candidate>,
+    /// Whether the node has widened to every rule after its sample ran dry.
+    widened: bool,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    piece: Placement,
+    b: CellBox,
+    committed: Option<u32>,
+    anchor: Anchor,
+    anchor_box: Option<(CellBox, Option<u32>)>,
+    rule: Option<crate::grammar::RuleId>,
+}
+
+/// How a part's search ended.
+pub(crate) enum PartResult {
+    /// The removals from first peeled to last: reverse for the build order.
+    Built(Vec<Removal>),
+    /// The search space was exhausted: these voxels cannot be built by R.
+    Unbuildable,
+    /// The node or time budget ran out.
+    OutOfBudget,
+}
+
+pub(crate) struct PartSearch<'a> {
+    rules: &'a RuleSet,
+    opts: &'a SearchOptions,
+    starts: Vec<(PartKind, Rot)>,
+    footprints: Vec<(i32, i32)>,
+    /// Every variant, grouped by the new piece's shape.
+    by_shape: Vec<u32>,
+    weights: Vec<f64>,
+    deadline: Instant,
+}
+
+impl<'a> PartSearch<'a> {
+    pub fn new(rules: &'a RuleSet, opts: &'a SearchOptions, deadline: Instant) -> Self {
+        let mut starts = Vec::new();
+        for s in rules.starts() {
+            for rot in [Rot::R0, Rot::R90] {
+                let r = s.part.spec().canonical_rot(rot);
+                if !starts.contains(&(s.part, r)) {
+                    starts.push((s.part, r));
+                }
+            }
+        }
+        // Bigger pieces first, so a piece on the built part takes the most.
+        starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
+        let weights = rules.variants().iter().map(|v| v.weight).collect();
+        let mut footprints: Vec<(i32, i32)> = Vec::new();
+        for p in rules.alphabet() {
+            for rot in [Rot::R0, Rot::R90] {
+                let f = p.spec().footprint(rot);
+                if !footprints.contains(&f) {
+                    footprints.push(f);
+                }
+            }
+        }
+        // Small footprints first: they fit most often.
+        footprints.sort_by_key(|&(x, y)| (x * y, x, y));
+        let mut by_shape: Vec<u32> = (0..rules.variants().len() as u32).collect();
+        by_shape.sort_by_key(|&i| {
+            let v = &rules.variants()[i as usize];
+            (v.added, v.added_rot, i)
+        });
+        PartSearch { rules, opts, starts, footprints, by_shape, weights, deadline }
+    }
+
+    /// Samples `b` distinct variants, weighted (Efraimidis–Spirakis keys),
+    /// in the order drawn; split by direction.
+    fn sample(&self, b: usize, rng: &mut ChaCha8Rng) -> (Vec<Slot>, Vec<Slot>) {
+        let mut keyed: Vec<(f64, u32)> = self
+            .weights
+            .iter()
+            .enumerate()
+            .map(|(i, &w)| {
+                let u: f64 = rng.gen_range(f64::EPSILON..1.0);
+                (u.ln() / w, i as u32)
+            })
+            .collect();
+        let b = b.min(keyed.len());
+        if b < keyed.len() {
+            keyed.select_nth_unstable_by(b, |a, c| c.0.total_cmp(&a.0));
+            keyed.truncate(b);
+        }
+        keyed.sort_by(|a, c| c.0.total_cmp(&a.0).then(a.1.cmp(&c.1)));
+        let mut up = Vec::new();
+        let mut down = Vec::new();
+        for (_, i) in keyed {
+            match self.rules.variants()[i as usize].dir {
+                Dir::Up => up.push(Slot::Rule(i)),
+                Dir::Down => down.push(Slot::Rule(i)),
+            }
+        }
+        (up, down)
+    }
+
+    fn branching(&self, left: usize, total: usize) -> usize {
+        let done = 1.0 - left as f64 / total.max(1) as f64;
+        let (lo, hi) = (self.opts.b_min as f64, self.opts.b_max as f64);
+        (lo + (hi - lo) * done * done).round() as usize
+    }
+
+    fn frame(&self, st: &State, total: usize, rng: &mut ChaCha8Rng, applied: Option<Removal>) -> Frame {
+        let b = self.branching(st.v.count(), total);
+        let (mut up, mut down) = self.sample(b, rng);
+        if st.has_built() {
+            up.extend(self.starts.iter().map(|&(p, r)| Slot::OnBuilt(p, r)));
+        } else {
+            up.append(&mut down);
+        }
+        Frame {
+            applied,
+            up,
+            down,
+            phase: Phase::Up,
+            pos: 0,
+            slot: 0,
+            deferred: Vec::new(),
+            widened: false,
+        }
+    }
+
+    /// Runs the backward tracing on `v` given the structure built before.
+    pub fn run(&self, v: VoxelGrid, built: &VoxelGrid, rng: &mut ChaCha8Rng, stats: &mut SearchStats) -> PartResult {
+        let total = v.count();
+        let orders = scan_orders(&v, !built.is_empty());
+        let mut st = State::new(v, built, self.footprints.clone());
+        let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None)];
+        let mut nodes_here = 0u64;
+        loop {
+            if st.v.is_empty() {
+                return PartResult::Built(self.trace(&stack));
+            }
+            if let Some(last) = self.start_rule(&st) {
+                let mut t = self.trace(&stack);
+                t.push(last);
+                stats.starts += 1;
+                return PartResult::Built(t);
+            }
+            if nodes_here >= self.opts.max_nodes_per_part || (nodes_here % 256 == 0 && Instant::now() >= self.deadline) {
+                return PartResult::OutOfBudget;
+            }
+            let top = stack.last_mut().expect("root frame");
+            match self.next_candidate(&mut st, top, &orders, stats) {
+                Some(c) => {
+                    let removal = st.apply(
+                        c.piece,
+                        &c.b,
+                        c.committed,
+                        c.anchor,
+                        c.anchor_box.as_ref().map(|(b, id)| (b, *id)),
+                        c.rule,
+                    );
+                    nodes_here += 1;
+                    stats.nodes += 1;
+                    let f = self.frame(&st, total, rng, Some(removal));
+                    stack.push(f);
+                    if stack.len() as u64 > stats.max_depth && std::env::var_os("BW_DUMP").is_some() {
+                        eprintln!("depth {} via {:?}\n{}", stack.len(), c.piece, st.dump());
+                    }
+                    stats.max_depth = stats.max_depth.max(stack.len() as u64);
+                }
+                None => {
+                    let f = stack.pop().expect("frame");
+                    match f.applied {
+                        Some(r) => {
+                            st.undo(&r);
+                            stats.backtracks += 1;
+                        }
+                        None => {
+                                        return PartResult::Unbuildable;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn trace(&self, stack: &[Frame]) -> Vec<Removal> {
+        stack.iter().filter_map(|f| f.applied).collect()
+    }
+
+    /// The starting rule `ε -> P`, reversed: the voxels left are one piece.
+    fn start_rule(&self, st: &State) -> Option<Removal> {
+        if st.has_built() {
+            return None;
+        }
+        let bounds = st.v.bounds()?;
+        if bounds.sz != 1 {
+            return None;
+        }
+        for &(part, rot) in &self.starts {
+            let (sx, sy) = part.spec().footprint(rot);
+            if (sx, sy) != (bounds.sx, bounds.sy) {
+                continue;
+            }
+            let p = Placement::new(part, bounds.min, rot);
+            if st.is_single_piece(&p) && st.commitment(&bounds, &p).is_some() {
+                return Some(Removal::new_start(p));
+            }
+        }
+        None
+    }
+
+    /// The next applicable match of the node, in scan order; `None` when the
+    /// node is exhausted. The returned match has passed every check.
+    fn next_candidate(
+        &self,
+        st: &mut State,
+        f: &mut Frame,
+        orders: &(Vec<Cell>, Vec<Cell>),
+        stats: &mut SearchStats,
+    ) -> Option<Candidate> {
+        let built = st.has_built();
+        loop {
+            match f.phase {
+                Phase::Done if f.widened => return None,
+                Phase::Done => {
+                    // The sampled rules found nothing: b reaches its maximum,
+                    // every rule not yet tried.
+                    let tried: std::collections::HashSet<u32> = f
+                        .up
+                        .iter()
+                        .chain(&f.down)
+                        .filter_map(|s| match s {
+                            Slot::Rule(i) => Some(*i),
+                            Slot::OnBuilt(..) => None,
+                        })
+                        .collect();
+                    f.up.clear();
+                    f.down.clear();
+                    for &i in &self.by_shape {
+                        if tried.contains(&i) {
+                            continue;
+                        }
+                        match (self.rules.variants()[i as usize].dir, built) {
+                            (Dir::Down, true) => f.down.push(Slot::Rule(i)),
+                            _ => f.up.push(Slot::Rule(i)),
+                        }
+                    }
+                    f.widened = true;
+                    f.phase = Phase::Up;
+                    f.pos = 0;
+                    f.slot = 0;
+                    stats.widened += 1;
+                }
+                Phase::Deferred => {
+                    while let Some(c) = f.deferred.pop() {
+                        if self.passes(st, &c, stats) {
+                            return Some(c);
+                        }
+                    }
+                    f.phase = Phase::Done;
+                }
+                Phase::Up | Phase::Down => {
+                    let order = if f.phase == Phase::Up { &orders.0 } else { &orders.1 };
+                    let slots = if f.phase == Phase::Up { &f.up } else { &f.down };
+                    while f.pos < order.len() && !st.v.get(order[f.pos]) {
+                        f.pos += 1;
+                        f.slot = 0;
+                    }
+                    if f.pos >= order.len() {
+                        if f.phase == Phase::Up && built {
+                            f.phase = Phase::Down;
+                        } else {
+                            f.deferred.reverse();
+                            f.phase = Phase::Deferred;
+                        }
+                        f.pos = 0;
+                        f.slot = 0;
+                        continue;
+                    }
+                    let cell = order[f.pos];
+                    let mut fit: Option<(PartKind, Rot, Option<Option<u32>>)> = None;
+                    while f.slot < slots.len() {
+                        let slot = slots[f.slot];
+                        f.slot += 1;
+                        stats.match_tries += 1;
+                        if let Some(c) = self.match_at(st, slot, cell, &mut fit) {
+                            if !built && !st.on_side_boundary(&c.b) {
+                                continue;
+                            }
+                            // With nothing built, the matched piece to continue
+                            // from is a committed anchor: peel it next, so the
+                            // peel follows the chain of staggered joints.
+                            let connected = if !built {
+                                c.committed.is_some() || !st.has_committed()
+                            } else {
+                                !st.any_matched
+                                || c.committed.is_some()
+                                || matches!(c.anchor_box, Some((_, Some(_))))
+                                || st.touches_matched(&c.b)
+                            };
+                            if !connected {
+                                if f.deferred.len() < 256 {
+                                    f.deferred.push(c);
+                                }
+                                continue;
+                            }
+                            if self.passes(st, &c, stats) {
+                                return Some(c);
+                            }
+                        }
+                    }
+                    f.pos += 1;
+                    f.slot = 0;
+                }
+            }
+        }
+    }
+
+    /// The structural match of `slot` with its new piece's minimum corner at
+    /// `cell`: pieces inside the voxels, consistent with matched pieces.
+    fn match_at(
+        &self,
+        st: &State,
+        slot: Slot,
+        cell: Cell,
+        fit: &mut Option<(PartKind, Rot, Option<Option<u32>>)>,
+    ) -> Option<Candidate> {
+        match slot {
+            Slot::Rule(i) => {
+                let v = &self.rules.variants()[i as usize];
+                let piece = Placement::new(v.added, cell, v.added_rot);
+                let b = boxed(&piece);
+                let committed = match *fit {
+                    Some((p, r, c)) if (p, r) == (v.added, v.added_rot) => c,
+                    _ => {
+                        let c = if st.v.all_set(&b) { st.commitment(&b, &piece) } else { None };
+                        *fit = Some((v.added, v.added_rot, c));
+                        c
+                    }
+                }?;
+                let (dx, dy, dz) = v.offset;
+                let a_at = cell.offset(-dx, -dy, -dz);
+                let anchor = Placement::new(v.anchor, a_at, v.anchor_rot);
+                let a = boxed(&anchor);
+                if !st.v.all_set(&a) {
+                    return None;
+                }
+                let a_committed = st.commitment(&a, &anchor)?;
+                Some(Candidate {
+                    piece,
+                    b,
+                    committed,
+                    anchor: Anchor::Piece(anchor),
+                    anchor_box: Some((a, a_committed)),
+                    rule: Some(v.rule),
+                })
+            }
+            Slot::OnBuilt(part, rot) => {
+                let piece = Placement::new(part, cell, rot);
+                let b = boxed(&piece);
+                if !st.v.all_set(&b) || !st.touches_built(&b) {
+                    return None;
+                }
+                let committed = st.commitment(&b, &piece)?;
+                Some(Candidate { piece, b, committed, anchor: Anchor::Built, anchor_box: None, rule: None })
+            }
+        }
+    }
+
+    /// The checks that need the removal applied: placeability and
+    /// connectivity. Leaves the state unchanged.
+    fn passes(&self, st: &mut State, c: &Candidate, stats: &mut SearchStats) -> bool {
+        let r = st.apply(c.piece, &c.b, c.committed, c.anchor, c.anchor_box.as_ref().map(|(b, id)| (b, *id)), c.rule);
+        let new_anchor = match c.anchor_box {
+            Some((ab, None)) => Some(ab),
+            _ => None,
+        };
+        let ok_place = st.placeable(&c.b);
+        let ok_conn = ok_place && st.still_connected(&c.b, new_anchor.as_ref());
+        let ok = ok_conn && st.still_reachable(&c.b, new_anchor.as_ref());
+        if !ok_place {
+            stats.rejected_placeable += 1;
+        } else if !ok_conn {
+            stats.rejected_connect += 1;
+        } else if !ok {
+            stats.rejected_reach += 1;
+        }
+        st.undo(&r);
+        ok
+    }
+}
+
+
+/// The cell orders the scans follow. With a structure built below, up rules
+/// scan from the top layer down and down rules from the bottom up, each layer
+/// from the outside in. With nothing built (the bottom part), the scan goes
+/// from the outside in over all layers together, top first, so the pieces
+/// peeled last, the first ones built, sit in the middle.
+fn scan_orders(v: &VoxelGrid, built: bool) -> (Vec<Cell>, Vec<Cell>) {
+    let cells: Vec<Cell> = v.cells().collect();
+    let Some(b) = v.bounds() else {
+        return (Vec::new(), Vec::new());
+    };
+    // Twice the centre, to stay in integers.
+    let (cx, cy) = (2 * b.min.x + b.sx - 1, 2 * b.min.y + b.sy - 1);
+    let dist = |c: &Cell| {
+        let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
+        dx * dx + dy * dy
+    };
+    let mut down = cells.clone();
+    let mut up = cells;
+    if built {
+        up.sort_by_key(|c| (std::cmp::Reverse(c.z), std::cmp::Reverse(dist(c)), c.y, c.x));
+        down.sort_by_key(|c| (c.z, std::cmp::Reverse(dist(c)), c.y, c.x));
+    } else {
+        up.sort_by_key(|c| (std::cmp::Reverse(dist(c)), std::cmp::Reverse(c.z), c.y, c.x));
+        down.clear();
+    }
+    (up, down)
+}

@@ -1,0 +1,339 @@
+//! The bottom part, which nothing holds from below, generated forward.
+//!
+//! Backward tracing keeps what is left buildable with local checks; that is
+//! enough where every piece can rest on the structure built below (every
+//! part but the first), and not enough for the bottom layers, where the
+//! pieces must interlock among themselves and whether the rest can still be
+//! joined depends on a layout not yet chosen. There the same rewriting
+//! system runs in its generative direction: a starting rule puts the first
+//! piece in the middle, and each step applies a basic rule `A -> A + B` to a
+//! piece `A` already placed, with rules sampled from their frequencies and
+//! the same adaptive branching factor, depth first with backtracking. The
+//! voxel nearest the first piece that is still uncovered is the one the next
+//! piece must cover, so the build grows outward and stays connected by
+//! construction. The result is handed on as the equivalent backward trace.
+
+use std::time::Instant;
+
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use super::dfs::PartResult;
+use super::state::{boxed, Anchor, Removal};
+use super::{SearchOptions, SearchStats};
+use crate::assembly::Placement;
+use crate::geom::{Cell, CellBox, Rot};
+use crate::grammar::RuleSet;
+use crate::voxel::VoxelGrid;
+
+const NONE: u32 = u32::MAX;
+
+struct Frame {
+    target: Cell,
+    slots: Vec<u32>,
+    slot: usize,
+    corner: usize,
+    widened: bool,
+    placed: bool,
+}
+
+/// Grows a build of `v` forward from a starting piece near its middle.
+pub(crate) fn grow(
+    v: &VoxelGrid,
+    rules: &RuleSet,
+    opts: &SearchOptions,
+    deadline: Instant,
+    rng: &mut ChaCha8Rng,
+    stats: &mut SearchStats,
+) -> PartResult {
+    let Some(bounds) = v.bounds() else {
+        return PartResult::Built(Vec::new());
+    };
+    let (nx, ny, nz) = v.dims();
+    let total = v.count();
+    // Seed cell: the cell of the lowest layer nearest the middle.
+    let (cx, cy) = (2 * bounds.min.x + bounds.sx - 1, 2 * bounds.min.y + bounds.sy - 1);
+    let seed = v
+        .layer_cells(bounds.min.z)
+        .min_by_key(|c| {
+            let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
+            (dx * dx + dy * dy, c.y, c.x)
+        })
+        .expect("non-empty bottom layer");
+    let dist = distances(v, seed);
+    let mut cover = VoxelGrid::new(nx, ny, nz);
+    let mut owner = vec![NONE; v.len()];
+    let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
+
+    // The start: the biggest starting piece over the seed that fits.
+    let mut starts: Vec<(crate::catalog::PartKind, Rot)> = Vec::new();
+    for s in rules.starts() {
+        for rot in [Rot::R0, Rot::R90] {
+            let r = s.part.spec().canonical_rot(rot);
+            if !starts.contains(&(s.part, r)) {
+                starts.push((s.part, r));
+            }
+        }
+    }
+    starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
+    let mut first = None;
+    'outer: for &(part, rot) in &starts {
+        let (sx, sy) = part.spec().footprint(rot);
+        for oy in 0..sy {
+            for ox in 0..sx {
+                let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
+                if v.all_set(&boxed(&p)) {
+                    first = Some(p);
+                    break 'outer;
+                }
+            }
+        }
+    }
+    let Some(first) = first else {
+        return PartResult::Unbuildable;
+    };
+    let place = |p: &Placement, cover: &mut VoxelGrid, owner: &mut Vec<u32>, id: u32| {
+        let b = boxed(p);
+        cover.set_box(&b, true);
+        for c in b.cells() {
+            owner[v.index(c)] = id;
+        }
+    };
+    place(&first, &mut cover, &mut owner, 0);
+    placed.push((first, Anchor::Start, None));
+    stats.starts += 1;
+
+    let weights: Vec<f64> = rules.variants().iter().map(|x| x.weight).collect();
+    let mut by_shape: Vec<u32> = (0..weights.len() as u32).collect();
+    by_shape.sort_by_key(|&i| {
+        let x = &rules.variants()[i as usize];
+        (std::cmp::Reverse(x.added.spec().studs()), x.added, x.added_rot, i)
+    });
+    let mut shapes: Vec<(i32, i32)> = Vec::new();
+    for p in rules.alphabet() {
+        for rot in [Rot::R0, Rot::R90] {
+            let s = p.spec().footprint(rot);
+            if !shapes.contains(&s) {
+                shapes.push(s);
+            }
+        }
+    }
+    shapes.sort_by_key(|&(x, y)| (x * y, x, y));
+    let mut stack: Vec<Frame> = Vec::new();
+    let mut nodes = 0u64;
+    loop {
+        let left = total - cover.count();
+        if left == 0 {
+            let trace = placed.iter().rev().map(|&(p, a, r)| Removal::forward(p, a, r)).collect();
+            return PartResult::Built(trace);
+        }
+        if nodes >= opts.max_nodes_per_part || (nodes % 256 == 0 && Instant::now() >= deadline) {
+            return PartResult::OutOfBudget;
+        }
+        // The frame for the current state, if not yet made.
+        if stack.last().is_none_or(|f| f.placed) {
+            let target = nearest_uncovered(v, &cover, &dist);
+            let done = 1.0 - left as f64 / total as f64;
+            let b = (opts.b_min as f64 + (opts.b_max - opts.b_min) as f64 * done * done) as usize;
+            let slots = sample(&weights, b, rng);
+            stack.push(Frame { target, slots, slot: 0, corner: 0, widened: false, placed: false });
+        }
+        let f = stack.last_mut().expect("frame");
+        let mut found: Option<(Placement, Placement, u32)> = None;
+        'scan: loop {
+            while f.slot < f.slots.len() {
+                let vi = f.slots[f.slot];
+                let var = &rules.variants()[vi as usize];
+                let (sx, sy) = var.added.spec().footprint(var.added_rot);
+                while f.corner < (sx * sy) as usize {
+                    let (ox, oy) = (f.corner as i32 % sx, f.corner as i32 / sx);
+                    f.corner += 1;
+                    stats.match_tries += 1;
+                    let p = Placement::new(var.added, f.target.offset(-ox, -oy, 0), var.added_rot);
+                    let b = boxed(&p);
+                    if !v.all_set(&b) || cover.any_set(&b) {
+                        continue;
+                    }
+                    let (dx, dy, dz) = var.offset;
+                    let a = Placement::new(var.anchor, p.origin.offset(-dx, -dy, -dz), var.anchor_rot);
+                    let a_box = boxed(&a);
+                    if !cover.in_bounds(a.origin) {
+                        continue;
+                    }
+                    let id = owner[v.index(a.origin)];
+                    if id == NONE || placed[id as usize].0 != a || !cover.all_set(&a_box) {
+                        continue;
+                    }
+                    if !placeable(&cover, &b) {
+                        stats.rejected_placeable += 1;
+                        continue;
+                    }
+                    cover.set_box(&b, true);
+                    let ok = still_coverable(v, &cover, &b, &shapes);
+                    cover.set_box(&b, false);
+                    if !ok {
+                        stats.rejected_reach += 1;
+                        continue;
+                    }
+                    found = Some((p, a, var.rule.0));
+                    break 'scan;
+                }
+                f.slot += 1;
+                f.corner = 0;
+            }
+            if f.widened {
+                break;
+            }
+            let tried: std::collections::HashSet<u32> = f.slots.iter().copied().collect();
+            f.slots = by_shape.iter().copied().filter(|i| !tried.contains(i)).collect();
+            f.slot = 0;
+            f.corner = 0;
+            f.widened = true;
+            stats.widened += 1;
+        }
+        match found {
+            Some((p, a, rule)) => {
+                let id = placed.len() as u32;
+                place(&p, &mut cover, &mut owner, id);
+                placed.push((p, Anchor::Piece(a), Some(crate::grammar::RuleId(rule))));
+                f.placed = true;
+                nodes += 1;
+                stats.nodes += 1;
+                stats.max_depth = stats.max_depth.max(placed.len() as u64);
+                // The child frame is made on the next turn.
+            }
+            None => {
+                if std::env::var_os("BW_DUMP").is_some() && stats.backtracks == 0 {
+                    let (nx, ny, nz) = v.dims();
+                    eprintln!("dead end at target {:?}", f.target);
+                    for z in (0..nz).rev() {
+                        for y in 0..ny {
+                            let row: String = (0..nx)
+                                .map(|x| {
+                                    let c = Cell::new(x, y, z);
+                                    if !v.get(c) { ' ' } else if cover.get(c) {
+                                        (b'a' + (owner[v.index(c)] % 26) as u8) as char
+                                    } else { '.' }
+                                })
+                                .collect();
+                            eprintln!("{row}");
+                        }
+                        eprintln!();
+                    }
+                }
+                // Dead end: undo the piece that led here and try its next option.
+                stack.pop();
+                stats.backtracks += 1;
+                let Some(parent) = stack.last_mut() else {
+                    return PartResult::Unbuildable;
+                };
+                let (p, _, _) = placed.pop().expect("a placed piece per frame");
+                let b = boxed(&p);
+                cover.set_box(&b, false);
+                for c in b.cells() {
+                    owner[v.index(c)] = NONE;
+                }
+                parent.placed = false;
+            }
+        }
+    }
+}
+
+/// Breadth-first distances from `seed` through face-adjacent voxels.
+fn distances(v: &VoxelGrid, seed: Cell) -> Vec<u32> {
+    let mut d = vec![u32::MAX; v.len()];
+    let mut q = std::collections::VecDeque::new();
+    d[v.index(seed)] = 0;
+    q.push_back(seed);
+    while let Some(c) = q.pop_front() {
+        let dc = d[v.index(c)];
+        for n in [c.offset(1, 0, 0), c.offset(-1, 0, 0), c.offset(0, 1, 0), c.offset(0, -1, 0), c.offset(0, 0, 1), c.offset(0, 0, -1)] {
+            if v.get(n) && d[v.index(n)] == u32::MAX {
+                d[v.index(n)] = dc + 1;
+                q.push_back(n);
+            }
+        }
+    }
+    d
+}
+
+/// The next voxel to cover: the nearest to the start among those with a
+/// placed piece directly above or below (so some piece over it connects),
+/// else the nearest of all.
+fn nearest_uncovered(v: &VoxelGrid, cover: &VoxelGrid, dist: &[u32]) -> Cell {
+    v.cells()
+        .filter(|&c| !cover.get(c))
+        .min_by_key(|&c| {
+            let supported = cover.get(c.offset(0, 0, 1)) || cover.get(c.offset(0, 0, -1));
+            (!supported, dist[v.index(c)], std::cmp::Reverse(c.z), c.y, c.x)
+        })
+        .expect("an uncovered voxel")
+}
+
+fn sample(weights: &[f64], b: usize, rng: &mut ChaCha8Rng) -> Vec<u32> {
+    let mut keyed: Vec<(f64, u32)> = weights
+        .iter()
+        .enumerate()
+        .map(|(i, &w)| (rng.gen_range(f64::EPSILON..1.0f64).ln() / w, i as u32))
+        .collect();
+    let b = b.min(keyed.len());
+    if b < keyed.len() {
+        keyed.select_nth_unstable_by(b, |a, c| c.0.total_cmp(&a.0));
+        keyed.truncate(b);
+    }
+    keyed.sort_by(|a, c| c.0.total_cmp(&a.0).then(a.1.cmp(&c.1)));
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// Pressed straight down or straight up through cells not yet built.
+fn placeable(cover: &VoxelGrid, b: &CellBox) -> bool {
+    let (_, _, nz) = cover.dims();
+    let top = b.min.z + b.sz;
+    let above = CellBox { min: b.min.offset(0, 0, b.sz), sz: (nz - top).max(1), ..*b };
+    let below = CellBox { min: Cell::new(b.min.x, b.min.y, 0), sz: b.min.z.max(1), ..*b };
+    top >= nz || !cover.any_set(&above) || b.min.z == 0 || !cover.any_set(&below)
+}
+
+/// Whether every uncovered voxel near `b` can still be covered in some
+/// order: a voxel can be covered once some piece over it, fitting the
+/// uncovered voxels, has a voxel directly above or below that is covered,
+/// or can itself be covered first (a fixpoint over a window around `b`;
+/// voxels outside the window are assumed coverable).
+fn still_coverable(v: &VoxelGrid, cover: &VoxelGrid, b: &CellBox, shapes: &[(i32, i32)]) -> bool {
+    let w = CellBox { min: b.min.offset(-4, -4, -2), sx: b.sx + 8, sy: b.sy + 8, sz: b.sz + 4 };
+    let cells: Vec<Cell> = w.cells().filter(|&c| v.get(c) && !cover.get(c)).collect();
+    if cells.is_empty() {
+        return true;
+    }
+    let local = |c: Cell| {
+        let d = c.offset(-w.min.x, -w.min.y, -w.min.z);
+        ((d.z * w.sy + d.y) * w.sx + d.x) as usize
+    };
+    let mut ok = vec![false; w.volume() as usize];
+    let free = |bx: &CellBox| v.all_set(bx) && !cover.any_set(bx);
+    let mut pending = cells;
+    loop {
+        let before = pending.len();
+        pending.retain(|&u| {
+            let support = |c: Cell| v.get(c) && (cover.get(c) || !w.contains(c) || ok[local(c)]);
+            let coverable = shapes.iter().any(|&(sx, sy)| {
+                (0..sy).any(|oy| {
+                    (0..sx).any(|ox| {
+                        let bx = CellBox { min: u.offset(-ox, -oy, 0), sx, sy, sz: 1 };
+                        free(&bx) && bx.cells().any(|c| support(c.offset(0, 0, -1)) || support(c.offset(0, 0, 1)))
+                    })
+                })
+            });
+            if coverable {
+                ok[local(u)] = true;
+            }
+            !coverable
+        });
+        if pending.is_empty() {
+            return true;
+        }
+        if pending.len() == before {
+            return false;
+        }
+    }
+}
