@@ -489,7 +489,10 @@ mod tests {
                 Failure::Disconnected { components: 2 }
             ]
         );
-        assert!(report.to_string().contains("falls apart into 2"), "{report}");
+        assert!(
+            report.to_string().contains("falls apart into 2"),
+            "{report}"
+        );
     }
 
     #[test]
@@ -574,12 +577,12 @@ mod tests {
     /// placeable, followed by a 2x2 hanging under the roof's centre.
     fn hollow_box(open: bool) -> Assembly {
         let mut p = vec![
-            ("2456", 0, 0, 0, R0), // floor row y 0..1
-            ("3009", 0, 0, 1, R0), // wall y = 0
+            ("2456", 0, 0, 0, R0),  // floor row y 0..1
+            ("3009", 0, 0, 1, R0),  // wall y = 0
             ("3010", 0, 1, 1, R90), // wall x = 0, y 1..4
-            ("2456", 0, 2, 0, R0), // floor row y 2..3, pressed from below
-            ("2456", 0, 4, 0, R0), // floor row y 4..5
-            ("3009", 0, 5, 1, R0), // wall y = 5
+            ("2456", 0, 2, 0, R0),  // floor row y 2..3, pressed from below
+            ("2456", 0, 4, 0, R0),  // floor row y 4..5
+            ("3009", 0, 5, 1, R0),  // wall y = 5
         ];
         if !open {
             p.push(("3010", 5, 1, 1, R90)); // wall x = 5

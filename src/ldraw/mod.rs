@@ -240,8 +240,8 @@ pub enum LdrError {
         line: usize,
         /// The part name.
         part: String,
-        /// The composed matrix, row-major.
-        matrix: [[f64; 3]; 3],
+        /// The composed matrix, row-major (boxed to keep the error small).
+        matrix: Box<[[f64; 3]; 3]>,
     },
     /// A submodel references itself, directly or through others.
     #[error("{}:{line}: submodel `{name}` contains itself", path.display())]

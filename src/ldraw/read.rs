@@ -126,10 +126,15 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
     for r in &model.parts {
         raw.push((to_placement(r, &model.path)?, r.step, r.color));
     }
-    let lo = raw.iter().fold(
-        Cell::new(i32::MAX, i32::MAX, i32::MAX),
-        |m, (p, _, _)| Cell::new(m.x.min(p.origin.x), m.y.min(p.origin.y), m.z.min(p.origin.z)),
-    );
+    let lo = raw
+        .iter()
+        .fold(Cell::new(i32::MAX, i32::MAX, i32::MAX), |m, (p, _, _)| {
+            Cell::new(
+                m.x.min(p.origin.x),
+                m.y.min(p.origin.y),
+                m.z.min(p.origin.z),
+            )
+        });
     let mut pieces = Vec::with_capacity(raw.len());
     let mut step = 0;
     let mut last_raw_step = None;
@@ -162,7 +167,7 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
         path: path.to_path_buf(),
         line: r.line,
         part: r.part.clone(),
-        matrix: r.matrix,
+        matrix: Box::new(r.matrix),
     })?;
     let spec = kind.spec();
     let (sx, sy) = spec.footprint(rot);
@@ -254,15 +259,12 @@ impl Xform {
     /// `self` applied after `inner`: the transform of a child placed by
     /// `inner` inside a model placed by `self`.
     fn compose(&self, inner: &Xform) -> Xform {
-        let mut m = [[0.0; 3]; 3];
-        let mut t = self.t;
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] = (0..3).map(|k| self.m[i][k] * inner.m[k][j]).sum();
-                t[i] += self.m[i][j] * inner.t[j];
-            }
+        let row = |i: usize, v: [f64; 3]| (0..3).map(|k| self.m[i][k] * v[k]).sum::<f64>();
+        let column = |j: usize| [inner.m[0][j], inner.m[1][j], inner.m[2][j]];
+        Xform {
+            m: [0, 1, 2].map(|i| [0, 1, 2].map(|j| row(i, column(j)))),
+            t: [0, 1, 2].map(|i| row(i, inner.t) + self.t[i]),
         }
-        Xform { m, t }
     }
 }
 
@@ -356,7 +358,8 @@ fn parse_sections(text: &str, path: &Path) -> Result<File, LdrError> {
                     continue;
                 }
                 Some((word, _))
-                    if word.eq_ignore_ascii_case("STEP") || word.eq_ignore_ascii_case("ROTSTEP") =>
+                    if word.eq_ignore_ascii_case("STEP")
+                        || word.eq_ignore_ascii_case("ROTSTEP") =>
                 {
                     Cmd::Step
                 }
@@ -414,7 +417,10 @@ fn parse_ref(mut rest: &str, path: &Path, line: usize) -> Result<RawRef, LdrErro
     };
     let (tok, r) = next_token(rest).ok_or_else(|| too_few(1))?;
     rest = r;
-    let color = tok.parse::<u16>().map(Color).map_err(|_| bad("colour", tok))?;
+    let color = tok
+        .parse::<u16>()
+        .map(Color)
+        .map_err(|_| bad("colour", tok))?;
     let mut nums = [0.0f64; 12];
     for (k, slot) in nums.iter_mut().enumerate() {
         let (tok, r) = next_token(rest).ok_or_else(|| too_few(2 + k))?;
@@ -537,12 +543,18 @@ mod tests {
         assert_eq!(m.parts[0].step, 0);
         // Both sub parts at main step 1; the 1x1 keeps its own colour.
         assert_eq!(
-            m.parts[1..].iter().map(|p| (p.step, p.color.0, p.line)).collect::<Vec<_>>(),
+            m.parts[1..]
+                .iter()
+                .map(|p| (p.step, p.color.0, p.line))
+                .collect::<Vec<_>>(),
             [(1, 4, 9), (1, 2, 11)]
         );
         // Child (40, 0, 20) turned R90 about (100, -24, 0): (100-20, -24, 40).
         assert_eq!(m.parts[1].pos, [80.0, -24.0, 40.0]);
-        assert_eq!(m.parts[1].matrix, [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]);
+        assert_eq!(
+            m.parts[1].matrix,
+            [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+        );
         assert_eq!(m.parts[2].pos, [100.0, -48.0, 0.0]);
     }
 
@@ -552,7 +564,10 @@ mod tests {
                     1 4 0 0 0 1 0 0 0 1 0 0 0 1 a.ldr\n";
         let e = parse(text).unwrap_err();
         assert!(matches!(e, LdrError::Recursion { line: 4, .. }), "{e}");
-        assert!(e.to_string().starts_with("t.ldr:4: submodel `a.ldr`"), "{e}");
+        assert!(
+            e.to_string().starts_with("t.ldr:4: submodel `a.ldr`"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -585,7 +600,14 @@ mod tests {
         );
         let e = parse("\n1 4 0 0 0 1 0 0").unwrap_err();
         assert!(
-            matches!(e, LdrError::TooFewFields { line: 2, found: 8, .. }),
+            matches!(
+                e,
+                LdrError::TooFewFields {
+                    line: 2,
+                    found: 8,
+                    ..
+                }
+            ),
             "{e}"
         );
         let e = parse("1 4 0 0 0 1 0 0 0 1 0 0 0 1").unwrap_err();

@@ -94,7 +94,10 @@ mod tests {
         };
         let text = write(&asm, &LdrMeta::default());
         let kinds: Vec<&str> = text.lines().map(|l| l.get(..3).unwrap_or(l)).collect();
-        assert_eq!(kinds, ["0", "0 N", "0 A", "1 1", "1 1", "0 S", "1 1", "0 S"]);
+        assert_eq!(
+            kinds,
+            ["0", "0 N", "0 A", "1 1", "1 1", "0 S", "1 1", "0 S"]
+        );
         assert!(text.ends_with("1 15 50 -24 10 1 0 0 0 1 0 0 0 1 3005.dat\n0 STEP\n"));
     }
 
