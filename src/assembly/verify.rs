@@ -1,1 +1,650 @@
-//! (being written)
+//! The independent verifier: checks an [`Assembly`] against the rules a
+//! real build must obey, without using any of the search's code.
+//!
+//! The search is clever and therefore easy to get subtly wrong; this module
+//! is deliberately plain, so that it can be the check on the search. It
+//! recomputes everything from the placements alone with sets of cells and a
+//! breadth-first search, clarity over speed.
+//!
+//! # The rules
+//!
+//! A piece fills the cells of [`Placement::cells_box`]. For the pieces in
+//! build order (`asm.pieces`):
+//!
+//! - **No overlap**: no two pieces share a cell ([`Failure::Overlap`]).
+//! - **Stud connection**: piece A is connected to piece B when A sits
+//!   directly below B (`A.min.z + A.sz == B.min.z`) and their footprints
+//!   overlap, or the reverse. Every piece after the first must be connected to
+//!   at least one *earlier* piece ([`Failure::NotConnected`]), and the whole
+//!   connection graph must be one component ([`Failure::Disconnected`]).
+//! - **Cover**: given a target voxel grid, the union of the pieces' cells
+//!   equals its filled cells exactly ([`Failure::CoverMismatch`]).
+//! - **Placeable at its turn** ([`Failure::NotPlaceable`]): let `O` be the
+//!   cells of all earlier pieces. The piece can be brought in from outside
+//!   iff, starting at its position, a breadth-first search over integer
+//!   translations of its box reaches a position whose box lies entirely
+//!   outside the bounding box of `O` (trivially so when `O` is empty).
+//!   A position is *free* when its box meets no cell of `O`. Moves go between
+//!   free positions: up or down one layer freely; sideways one stud only if,
+//!   at both ends, the layer just above and the layer just below the box
+//!   (over its footprint) hold no cell of `O` — the studs need half a voxel
+//!   of clearance, rounded to the grid, to slide. First a fast path: if the
+//!   footprint's column straight above the piece (up to the top of `O`) or
+//!   straight below it (down to the bottom of `O`) is empty, the piece is
+//!   placeable by a straight vertical move. A piece that overlaps an earlier
+//!   one is reported as an overlap only.
+//!
+//! # Example
+//!
+//! ```
+//! use brickwright::assembly::{verify::verify, Assembly, Placement};
+//! use brickwright::catalog::{Color, PartKind};
+//! use brickwright::geom::{Cell, Rot};
+//!
+//! let brick = PartKind::from_id("3001").unwrap();
+//! let order = [
+//!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+//!     Placement::new(brick, Cell::new(2, 0, 1), Rot::R0),
+//! ];
+//! let report = verify(&Assembly::from_order(&order, 3, Color::RED), None);
+//! assert!(report.is_ok(), "{report}");
+//! ```
+
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::fmt;
+
+use crate::assembly::{Assembly, Step};
+use crate::geom::{Cell, CellBox};
+use crate::voxel::VoxelGrid;
+
+#[cfg(doc)]
+use crate::assembly::Placement;
+
+/// One broken rule. Piece numbers are indices into `asm.pieces`, from 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Failure {
+    /// Pieces `a < b` share `cell` (the first shared cell of `b`'s box,
+    /// reported once per pair).
+    Overlap {
+        /// The earlier piece.
+        a: usize,
+        /// The later piece.
+        b: usize,
+        /// A cell both fill.
+        cell: Cell,
+    },
+    /// The piece is stud-connected to no earlier piece.
+    NotConnected {
+        /// The piece.
+        piece: usize,
+        /// Its step.
+        step: Step,
+    },
+    /// The earlier pieces enclose the piece: it cannot be moved into place.
+    NotPlaceable {
+        /// The piece.
+        piece: usize,
+        /// Its step.
+        step: Step,
+    },
+    /// The pieces' cells differ from the target's filled cells.
+    CoverMismatch {
+        /// Target cells no piece fills.
+        missing: usize,
+        /// Piece cells outside the target.
+        extra: usize,
+        /// The lowest differing cell (by layer, then row, then column).
+        first: Cell,
+    },
+    /// The connection graph falls apart into this many components.
+    Disconnected {
+        /// Number of components (at least 2).
+        components: usize,
+    },
+}
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let at = |c: &Cell| format!("({}, {}, {})", c.x, c.y, c.z);
+        match self {
+            Failure::Overlap { a, b, cell } => {
+                write!(f, "pieces #{a} and #{b} overlap at cell {}", at(cell))
+            }
+            Failure::NotConnected { piece, step } => write!(
+                f,
+                "piece #{piece} (step {}) is not stud-connected to any earlier piece",
+                step.0
+            ),
+            Failure::NotPlaceable { piece, step } => write!(
+                f,
+                "piece #{piece} (step {}) cannot be put in place: earlier pieces enclose it",
+                step.0
+            ),
+            Failure::CoverMismatch {
+                missing,
+                extra,
+                first,
+            } => write!(
+                f,
+                "the pieces do not cover the target: {missing} cells missing, {extra} extra, \
+                 first difference at {}",
+                at(first)
+            ),
+            Failure::Disconnected { components } => {
+                write!(f, "the build falls apart into {components} separate parts")
+            }
+        }
+    }
+}
+
+/// Everything [`verify`] found wrong; empty when the assembly is sound.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct VerifyReport {
+    /// The failures: overlaps first, then per piece in build order, then the
+    /// whole-build checks.
+    pub failures: Vec<Failure>,
+}
+
+impl VerifyReport {
+    /// Whether no rule is broken.
+    pub fn is_ok(&self) -> bool {
+        self.failures.is_empty()
+    }
+}
+
+impl fmt::Display for VerifyReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_ok() {
+            return write!(f, "assembly verified: no failures");
+        }
+        write!(f, "{} verification failure(s):", self.failures.len())?;
+        for failure in &self.failures {
+            write!(f, "\n  - {failure}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Checks `asm` against every rule of the module docs, and its cover against
+/// `target` when given.
+pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
+    let boxes: Vec<CellBox> = asm
+        .pieces
+        .iter()
+        .map(|p| p.placement.cells_box(asm.plates_per_layer))
+        .collect();
+    let steps: Vec<Step> = asm.pieces.iter().map(|p| p.step).collect();
+    let mut failures = check_overlaps(&boxes);
+    let overlapping: HashSet<usize> = failures
+        .iter()
+        .filter_map(|f| match f {
+            Failure::Overlap { b, .. } => Some(*b),
+            _ => None,
+        })
+        .collect();
+
+    let neighbours = connections(&boxes);
+    let mut occupied = Occupied::default();
+    for (i, b) in boxes.iter().enumerate() {
+        if i > 0 && !neighbours[i].iter().any(|&j| j < i) {
+            failures.push(Failure::NotConnected {
+                piece: i,
+                step: steps[i],
+            });
+        }
+        if !overlapping.contains(&i) && !placeable(b, &occupied) {
+            failures.push(Failure::NotPlaceable {
+                piece: i,
+                step: steps[i],
+            });
+        }
+        occupied.add(b);
+    }
+
+    let components = count_components(&neighbours);
+    if components > 1 {
+        failures.push(Failure::Disconnected { components });
+    }
+    if let Some(target) = target {
+        failures.extend(check_cover(&boxes, target));
+    }
+    VerifyReport { failures }
+}
+
+/// Every pair of pieces sharing a cell, with the first shared cell of the
+/// later piece.
+fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
+    let mut owners: HashMap<Cell, Vec<usize>> = HashMap::new();
+    let mut reported: HashSet<(usize, usize)> = HashSet::new();
+    let mut failures = Vec::new();
+    for (b, bx) in boxes.iter().enumerate() {
+        for cell in bx.cells() {
+            let here = owners.entry(cell).or_default();
+            for &a in here.iter() {
+                if reported.insert((a, b)) {
+                    failures.push(Failure::Overlap { a, b, cell });
+                }
+            }
+            here.push(b);
+        }
+    }
+    failures
+}
+
+/// For each piece, the pieces it is stud-connected to (directly above or
+/// below it with overlapping footprints).
+fn connections(boxes: &[CellBox]) -> Vec<Vec<usize>> {
+    let mut by_bottom: HashMap<i32, Vec<usize>> = HashMap::new();
+    for (i, b) in boxes.iter().enumerate() {
+        by_bottom.entry(b.min.z).or_default().push(i);
+    }
+    let mut neighbours = vec![Vec::new(); boxes.len()];
+    for (below, a) in boxes.iter().enumerate() {
+        let top = a.min.z + a.sz;
+        for &above in by_bottom.get(&top).into_iter().flatten() {
+            if a.footprints_overlap(&boxes[above]) {
+                neighbours[below].push(above);
+                neighbours[above].push(below);
+            }
+        }
+    }
+    neighbours
+}
+
+/// Number of connected components of the graph (0 for no pieces).
+fn count_components(neighbours: &[Vec<usize>]) -> usize {
+    let mut seen = vec![false; neighbours.len()];
+    let mut components = 0;
+    for start in 0..neighbours.len() {
+        if seen[start] {
+            continue;
+        }
+        components += 1;
+        seen[start] = true;
+        let mut stack = vec![start];
+        while let Some(i) = stack.pop() {
+            for &j in &neighbours[i] {
+                if !seen[j] {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+    }
+    components
+}
+
+/// The cover check: union of piece cells against the target's cells.
+fn check_cover(boxes: &[CellBox], target: &VoxelGrid) -> Option<Failure> {
+    let filled: HashSet<Cell> = boxes.iter().flat_map(|b| b.cells()).collect();
+    let missing: Vec<Cell> = target.cells().filter(|c| !filled.contains(c)).collect();
+    let extra: Vec<Cell> = filled.iter().copied().filter(|&c| !target.get(c)).collect();
+    let first = missing
+        .iter()
+        .chain(&extra)
+        .min_by_key(|c| (c.z, c.y, c.x))?;
+    Some(Failure::CoverMismatch {
+        missing: missing.len(),
+        extra: extra.len(),
+        first: *first,
+    })
+}
+
+/// The cells of the pieces placed so far, with their bounding box.
+#[derive(Debug, Default)]
+struct Occupied {
+    cells: HashSet<Cell>,
+    /// Inclusive minimum and maximum corners; `None` while empty.
+    bounds: Option<(Cell, Cell)>,
+}
+
+impl Occupied {
+    fn add(&mut self, b: &CellBox) {
+        self.cells.extend(b.cells());
+        let hi = b.max_excl().offset(-1, -1, -1);
+        self.bounds = Some(match self.bounds {
+            None => (b.min, hi),
+            Some((l, h)) => (
+                Cell::new(l.x.min(b.min.x), l.y.min(b.min.y), l.z.min(b.min.z)),
+                Cell::new(h.x.max(hi.x), h.y.max(hi.y), h.z.max(hi.z)),
+            ),
+        });
+    }
+
+    /// Whether any cell of `b` is occupied (an empty box has none).
+    fn any_in(&self, b: &CellBox) -> bool {
+        b.sz > 0 && b.cells().any(|c| self.cells.contains(&c))
+    }
+}
+
+/// The box `b` moved to minimum corner `min`.
+fn moved(b: &CellBox, min: Cell) -> CellBox {
+    CellBox { min, ..*b }
+}
+
+/// The placeability rule of the module docs.
+fn placeable(b: &CellBox, occ: &Occupied) -> bool {
+    let Some((lo, hi)) = occ.bounds else {
+        return true;
+    };
+    // Fast path: a straight drop from above or press from below.
+    let above = CellBox {
+        min: Cell::new(b.min.x, b.min.y, b.min.z + b.sz),
+        sz: (hi.z + 1 - (b.min.z + b.sz)).max(0),
+        ..*b
+    };
+    let below = CellBox {
+        min: Cell::new(b.min.x, b.min.y, lo.z),
+        sz: (b.min.z - lo.z).max(0),
+        ..*b
+    };
+    if !occ.any_in(&above) || !occ.any_in(&below) {
+        return true;
+    }
+    escapes(b, occ, lo, hi)
+}
+
+/// The breadth-first search: can `b` travel to a position whose box lies
+/// outside the bounding box `lo..=hi` of the occupied cells?
+fn escapes(b: &CellBox, occ: &Occupied, lo: Cell, hi: Cell) -> bool {
+    let outside = |p: Cell| {
+        p.x + b.sx <= lo.x
+            || p.x > hi.x
+            || p.y + b.sy <= lo.y
+            || p.y > hi.y
+            || p.z + b.sz <= lo.z
+            || p.z > hi.z
+    };
+    // Corners of the search region: the bounding box grown by the piece's
+    // size + 1 on every side. Every path out meets a goal before leaving it.
+    let (rmin, rmax) = (
+        lo.offset(-b.sx - 1, -b.sy - 1, -b.sz - 1),
+        hi.offset(1, 1, 1),
+    );
+    let in_region = |p: Cell| {
+        (rmin.x..=rmax.x).contains(&p.x)
+            && (rmin.y..=rmax.y).contains(&p.y)
+            && (rmin.z..=rmax.z).contains(&p.z)
+    };
+    let free = |p: Cell| !occ.any_in(&moved(b, p));
+    // Stud clearance: nothing just above or just below the box.
+    let clear = |p: Cell| {
+        let layer = |z| CellBox {
+            min: Cell::new(p.x, p.y, z),
+            sz: 1,
+            ..*b
+        };
+        !occ.any_in(&layer(p.z + b.sz)) && !occ.any_in(&layer(p.z - 1))
+    };
+
+    if !free(b.min) {
+        return false;
+    }
+    let mut seen = HashSet::from([b.min]);
+    let mut queue = VecDeque::from([b.min]);
+    while let Some(p) = queue.pop_front() {
+        if outside(p) {
+            return true;
+        }
+        let clear_here = clear(p);
+        let moves = [
+            (0, 0, 1, false),
+            (0, 0, -1, false),
+            (1, 0, 0, true),
+            (-1, 0, 0, true),
+            (0, 1, 0, true),
+            (0, -1, 0, true),
+        ];
+        for (dx, dy, dz, sideways) in moves {
+            let q = p.offset(dx, dy, dz);
+            if !in_region(q) || seen.contains(&q) || !free(q) {
+                continue;
+            }
+            if sideways && !(clear_here && clear(q)) {
+                continue;
+            }
+            seen.insert(q);
+            queue.push_back(q);
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Placement;
+    use crate::catalog::{Color, PartKind};
+    use crate::geom::Rot;
+
+    /// An assembly of bricks, one step each, from `(part, x, y, z, rot)`.
+    fn build(pieces: &[(&str, i32, i32, i32, Rot)]) -> Assembly {
+        let order: Vec<Placement> = pieces
+            .iter()
+            .map(|&(id, x, y, z, r)| {
+                Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, y, z), r)
+            })
+            .collect();
+        Assembly::from_order(&order, 3, Color::RED)
+    }
+
+    use Rot::{R0, R90};
+
+    #[test]
+    fn staggered_two_layer_wall_in_a_valid_order_passes_with_its_cover() {
+        // Layer 0: 1x4 at x 0..3 and 4..7; layer 1: 1x2, 1x4 across the
+        // joint, 1x2. The second bottom brick goes in after the bridge, so it
+        // is pressed up from below.
+        let asm = build(&[
+            ("3010", 0, 0, 0, R0),
+            ("3010", 2, 0, 1, R0),
+            ("3010", 4, 0, 0, R0),
+            ("3004", 0, 0, 1, R0),
+            ("3004", 6, 0, 1, R0),
+        ]);
+        let mut target = VoxelGrid::new(8, 1, 2);
+        target.set_box(
+            &CellBox {
+                min: Cell::new(0, 0, 0),
+                sx: 8,
+                sy: 1,
+                sz: 2,
+            },
+            true,
+        );
+        let report = verify(&asm, Some(&target));
+        assert!(report.is_ok(), "{report}");
+        assert_eq!(report.to_string(), "assembly verified: no failures");
+    }
+
+    #[test]
+    fn bottom_brick_before_its_bridge_is_not_connected() {
+        let asm = build(&[
+            ("3010", 0, 0, 0, R0),
+            ("3010", 4, 0, 0, R0),
+            ("3010", 2, 0, 1, R0),
+        ]);
+        let report = verify(&asm, None);
+        // Connected in the end (one component), but not at its turn.
+        assert_eq!(
+            report.failures,
+            [Failure::NotConnected {
+                piece: 1,
+                step: Step(2)
+            }]
+        );
+    }
+
+    #[test]
+    fn separate_pieces_are_disconnected() {
+        let asm = build(&[("3005", 0, 0, 0, R0), ("3005", 1, 0, 0, R0)]);
+        let report = verify(&asm, None);
+        assert_eq!(
+            report.failures,
+            [
+                Failure::NotConnected {
+                    piece: 1,
+                    step: Step(2)
+                },
+                Failure::Disconnected { components: 2 }
+            ]
+        );
+        assert!(
+            report.to_string().contains("falls apart into 2"),
+            "{report}"
+        );
+    }
+
+    #[test]
+    fn overlap_names_both_pieces_and_a_cell() {
+        // A 2x4 along x and one along y, crossing at (0..1, 0..1).
+        let asm = build(&[
+            ("3001", 0, 0, 0, R0),
+            ("3005", 5, 5, 1, R0),
+            ("3001", 0, 0, 0, R90),
+        ]);
+        let report = verify(&asm, None);
+        assert_eq!(
+            report.failures[0],
+            Failure::Overlap {
+                a: 0,
+                b: 2,
+                cell: Cell::new(0, 0, 0)
+            }
+        );
+        // The overlapping piece is not also called unplaceable.
+        assert!(!report
+            .failures
+            .iter()
+            .any(|f| matches!(f, Failure::NotPlaceable { .. })));
+    }
+
+    #[test]
+    fn cover_mismatch_counts_missing_and_extra_cells() {
+        let asm = build(&[("3004", 0, 0, 0, R0)]); // cells (0,0,0), (1,0,0)
+        let mut target = VoxelGrid::new(3, 1, 1);
+        target.set(Cell::new(1, 0, 0), true);
+        target.set(Cell::new(2, 0, 0), true);
+        let report = verify(&asm, Some(&target));
+        assert_eq!(
+            report.failures,
+            [Failure::CoverMismatch {
+                missing: 1,
+                extra: 1,
+                first: Cell::new(0, 0, 0)
+            }]
+        );
+    }
+
+    #[test]
+    fn piece_pressed_from_below_under_an_overhang_is_placeable() {
+        // A 2x2 column two bricks high carries a 2x4 sticking out along +x;
+        // a 2x2 then goes under the overhang at layer 1: the roof is above
+        // it, but nothing is below it, so it is pressed up from below.
+        let asm = build(&[
+            ("3003", 0, 0, 0, R0),
+            ("3003", 0, 0, 1, R0),
+            ("3001", 0, 0, 2, R0),
+            ("3003", 2, 0, 1, R0),
+        ]);
+        let report = verify(&asm, None);
+        assert!(report.is_ok(), "{report}");
+    }
+
+    #[test]
+    fn piece_sandwiched_between_floor_and_roof_is_not_placeable() {
+        // Floor 1x4, a 1x1 pillar, a 1x4 roof; then a 1x2 in the one-layer
+        // gap: its studs cannot slide under the roof.
+        let asm = build(&[
+            ("3010", 0, 0, 0, R0),
+            ("3005", 0, 0, 1, R0),
+            ("3010", 0, 0, 2, R0),
+            ("3004", 2, 0, 1, R0),
+        ]);
+        let report = verify(&asm, None);
+        assert_eq!(
+            report.failures,
+            [Failure::NotPlaceable {
+                piece: 3,
+                step: Step(4)
+            }]
+        );
+    }
+
+    /// A 6x6 box: floor at layer 0, walls at layers 1-3, roof at layer 4,
+    /// leaving a 4x4x3 hollow; the wall on the x = 5 side is left out when
+    /// `open`. Built in an order where every piece is connected and
+    /// placeable, followed by a 2x2 hanging under the roof's centre.
+    fn hollow_box(open: bool) -> Assembly {
+        let mut p = vec![
+            ("2456", 0, 0, 0, R0),  // floor row y 0..1
+            ("3009", 0, 0, 1, R0),  // wall y = 0
+            ("3010", 0, 1, 1, R90), // wall x = 0, y 1..4
+            ("2456", 0, 2, 0, R0),  // floor row y 2..3, pressed from below
+            ("2456", 0, 4, 0, R0),  // floor row y 4..5
+            ("3009", 0, 5, 1, R0),  // wall y = 5
+        ];
+        if !open {
+            p.push(("3010", 5, 1, 1, R90)); // wall x = 5
+        }
+        for z in 2..=3 {
+            p.push(("3009", 0, 0, z, R0));
+            p.push(("3010", 0, 1, z, R90));
+            p.push(("3009", 0, 5, z, R0));
+            if !open {
+                p.push(("3010", 5, 1, z, R90));
+            }
+        }
+        for y in [0, 2, 4] {
+            p.push(("2456", 0, y, 4, R0));
+        }
+        p.push(("3003", 2, 2, 3, R0));
+        build(&p)
+    }
+
+    #[test]
+    fn piece_inside_a_closed_box_is_not_placeable() {
+        let asm = hollow_box(false);
+        let last = asm.pieces.len() - 1;
+        let report = verify(&asm, None);
+        assert_eq!(
+            report.failures,
+            [Failure::NotPlaceable {
+                piece: last,
+                step: Step(last as u32 + 1)
+            }]
+        );
+    }
+
+    #[test]
+    fn piece_slid_in_under_a_roof_then_pressed_up_is_placeable() {
+        // Same box with the x = 5 wall missing: roof above and floor below
+        // defeat the fast path; the search lowers the 2x2 to layer 2 (clear
+        // above and below), slides it out along +x, and succeeds.
+        let asm = hollow_box(true);
+        let report = verify(&asm, None);
+        assert!(report.is_ok(), "{report}");
+    }
+
+    #[test]
+    fn five_thousand_piece_mat_verifies() {
+        // A 2-layer mat of 2x4s in running bond, 50 x 50 bricks a layer,
+        // built row by row so each piece touches an earlier one.
+        let mut p = Vec::new();
+        for j in 0..50 {
+            for k in 0..50 {
+                p.push(("3001", 4 * k, 2 * j, 0, R0));
+                p.push(("3001", 4 * k + 2, 2 * j + 1, 1, R0));
+            }
+        }
+        // (No timing assertion here: speed goals live in benches/.)
+        let report = verify(&build(&p), None);
+        assert!(report.is_ok(), "{report}");
+    }
+
+    #[test]
+    fn empty_and_single_piece_assemblies_pass() {
+        assert!(verify(&build(&[]), None).is_ok());
+        assert!(verify(&build(&[("3001", 7, -3, 2, R90)]), None).is_ok());
+    }
+}
