@@ -263,7 +263,7 @@ pub(crate) fn finish(path: &Path, raw: Mesh) -> Result<Mesh, MeshError> {
     }
     let (lo, hi) = bounds(&mesh.positions);
     let extent = (hi - lo).max_element();
-    if !(extent <= MAX_EXTENT) {
+    if extent > MAX_EXTENT {
         return Err(MeshError::TooLarge { at: at(), extent });
     }
     Ok(mesh)

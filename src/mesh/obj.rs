@@ -22,7 +22,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // Materials are irrelevant here; never open .mtl files.
     let (models, _materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
