@@ -6,3 +6,6 @@ mod grid;
 pub mod voxelize;
 
 pub use grid::VoxelGrid;
+pub use voxelize::{
+    to_grid_frame, voxelize, Sizing, Up, VoxelModel, VoxelizeError, VoxelizeOptions,
+};

@@ -1,0 +1,302 @@
+//! Wavefront OBJ: a line-based text format (`v x y z`, `f 1 2 3 ...`).
+//!
+//! `tobj` does the reading (polygons triangulated, every object and group
+//! merged), but its errors carry no line numbers. So the text is first
+//! checked here, line by line, for the mistakes users actually hit — a
+//! vertex with a non-numeric, NaN or infinite coordinate, a face with fewer
+//! than three corners or an index past the vertex list, binary content — and
+//! those are reported as `file.obj:17: ...`. Only what gets past that check
+//! is handed to `tobj`.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::{finish, Location, Mesh, MeshError};
+
+/// Parses the OBJ text in `bytes` (read from `path`, used in messages).
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let text = prescan(path, bytes)?;
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    // Materials are irrelevant here; never open .mtl files.
+    let (models, _materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| MeshError::Malformed {
+        at: Location::file(path),
+        reason: format!("not a valid OBJ file ({e}); re-export it"),
+    })?;
+    let mut raw = Mesh::default();
+    for model in &models {
+        let m = &model.mesh;
+        let base = raw.positions.len() as u32;
+        raw.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2])),
+        );
+        raw.triangles.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
+        );
+    }
+    finish(path, raw)
+}
+
+/// Checks the text line by line and returns it as a string.
+///
+/// Reports the first line with a bad vertex or face; `tobj` would either
+/// reject those without a line number or misread them.
+fn prescan<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshError> {
+    let bad = |line: usize, reason: String| MeshError::Malformed {
+        at: Location::line(path, line),
+        reason,
+    };
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) => t,
+        Err(e) => {
+            let line = 1 + bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            return Err(bad(
+                line,
+                "not text (invalid UTF-8); is this really an OBJ file?".into(),
+            ));
+        }
+    };
+    // Positive face indices may refer forward, so count all vertices first.
+    let total = logical_lines(text)
+        .filter(|(_, l)| l.split_whitespace().next() == Some("v"))
+        .count();
+    let mut seen = 0usize;
+    for (no, line) in logical_lines(text) {
+        if line.contains('\0') {
+            return Err(bad(
+                no,
+                "binary content (NUL byte); is this really an OBJ file?".into(),
+            ));
+        }
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                seen += 1;
+                let coords: Vec<&str> = words.take(3).collect();
+                if coords.len() < 3 {
+                    return Err(bad(
+                        no,
+                        format!("vertex has {} coordinates, needs 3", coords.len()),
+                    ));
+                }
+                for w in coords {
+                    let Ok(x) = w.parse::<f32>() else {
+                        return Err(bad(no, format!("vertex coordinate {w:?} is not a number")));
+                    };
+                    if !x.is_finite() {
+                        let what = if x.is_nan() { "a NaN" } else { "an infinite" };
+                        return Err(MeshError::NonFinite {
+                            at: Location::line(path, no),
+                            what,
+                        });
+                    }
+                }
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(bad(
+                        no,
+                        format!("face has {} corners, needs at least 3", corners.len()),
+                    ));
+                }
+                for c in corners {
+                    let first = c.split('/').next().unwrap_or("");
+                    let Ok(i) = first.parse::<i64>() else {
+                        return Err(bad(no, format!("face corner {c:?} is not a vertex index")));
+                    };
+                    // 1-based from the start, or negative: relative to the
+                    // vertices read so far.
+                    let ok = if i > 0 {
+                        i as u64 <= total as u64
+                    } else {
+                        i < 0 && i.unsigned_abs() <= seen as u64
+                    };
+                    if !ok {
+                        let count = if i < 0 { seen } else { total };
+                        return Err(MeshError::IndexOutOfRange {
+                            at: Location::line(path, no),
+                            index: i,
+                            count,
+                        });
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(text)
+}
+
+/// The file's statements with their 1-based starting line numbers: comments
+/// stripped, lines ending in `\` joined with the next.
+fn logical_lines(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
+    let mut lines = text.lines().enumerate().peekable();
+    std::iter::from_fn(move || {
+        let (i, first) = lines.next()?;
+        let mut joined = String::from(first);
+        while joined.ends_with('\\') {
+            joined.pop();
+            match lines.next() {
+                Some((_, next)) => {
+                    joined.push(' ');
+                    joined.push_str(next);
+                }
+                None => break,
+            }
+        }
+        if let Some(hash) = joined.find('#') {
+            joined.truncate(hash);
+        }
+        Some((i + 1, joined))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::{cube, write};
+    use super::super::{load, MeshError};
+
+    fn cube_obj() -> String {
+        let (v, t) = cube();
+        let mut s = String::from("# a cube\nmtllib missing.mtl\no cube\n");
+        for p in v {
+            s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        // Faces as quads split across two groups, to test merging and
+        // triangulation: pair up the triangles back into quads where simple.
+        s += "g first\n";
+        for tri in &t[..6] {
+            s += &format!("f {} {} {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+        }
+        s += "o second\n";
+        for tri in &t[6..] {
+            s += &format!("f {}/1 {}//2 {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+        }
+        s
+    }
+
+    #[test]
+    fn loads_cube_merging_objects() {
+        let f = write("cube.obj", cube_obj().as_bytes());
+        let m = load(&f.path).unwrap();
+        assert_eq!(m.triangles.len(), 12);
+        // Each object keeps its own copy of the vertices it uses.
+        assert!((8..=16).contains(&m.positions.len()));
+    }
+
+    #[test]
+    fn triangulates_polygons_and_negative_indices() {
+        let src = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4 -3 -2 -1\n";
+        let f = write("quad.obj", src.as_bytes());
+        let m = load(&f.path).unwrap();
+        assert_eq!(m.triangles.len(), 2);
+    }
+
+    fn err(src: &str) -> (MeshError, String) {
+        let f = write("bad.obj", src.as_bytes());
+        let e = load(&f.path).unwrap_err();
+        let msg = e.to_string();
+        (e, msg)
+    }
+
+    #[test]
+    fn nan_vertex_reports_line() {
+        let (e, msg) = err("# header\nv 0 0 0\nv 1 0 0\nv 0 NaN 0\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::NonFinite { .. }));
+        assert!(
+            msg.contains("bad.obj:4: vertex has a NaN coordinate"),
+            "{msg}"
+        );
+        let (_, msg) = err("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n");
+        assert!(
+            msg.contains("bad.obj:2:") && msg.contains("infinite"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn non_numeric_vertex_reports_line() {
+        let (e, msg) = err("v 0 0 0\nv 1 zero 0\n");
+        assert!(matches!(e, MeshError::Malformed { .. }));
+        assert!(
+            msg.contains("bad.obj:2:") && msg.contains("\"zero\""),
+            "{msg}"
+        );
+        let (_, msg) = err("v 0 0\n");
+        assert!(
+            msg.contains("bad.obj:1:") && msg.contains("needs 3"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn index_out_of_range_reports_line() {
+        let (e, msg) = err("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 4\n");
+        assert!(matches!(
+            e,
+            MeshError::IndexOutOfRange {
+                index: 4,
+                count: 3,
+                ..
+            }
+        ));
+        assert!(msg.contains("bad.obj:5:"), "{msg}");
+        let (_, msg) = err("v 0 0 0\nv 1 0 0\nf 0 1 2\n");
+        assert!(msg.contains("bad.obj:3:"), "{msg}");
+        let (_, msg) = err("v 0 0 0\nf -2 -1 -1\nv 1 0 0\n");
+        assert!(msg.contains("bad.obj:2:"), "{msg}");
+        let (_, msg) = err("v 0 0 0\nv 1 0 0\nf 1 x 2\n");
+        assert!(msg.contains("bad.obj:3:") && msg.contains("\"x\""), "{msg}");
+    }
+
+    #[test]
+    fn garbage_and_empty_files() {
+        let (e, msg) = err("\u{0}\u{1}\u{2}binary");
+        assert!(matches!(e, MeshError::Malformed { .. }), "{msg}");
+        let f = write("bin.obj", &[0xff, 0xfe, 0x00, 0x80, 0x81]);
+        let e = load(&f.path).unwrap_err();
+        assert!(e.to_string().contains("bin.obj:1:"), "{e}");
+        let (e, msg) = err("# nothing\nv 0 0 0\nv 1 1 1\n");
+        assert!(matches!(e, MeshError::Empty { .. }), "{msg}");
+        assert!(msg.contains("bad.obj"), "{msg}");
+        let (e, _) = err("v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::ZeroExtent { .. }));
+        let (e, _) = err("v 0 0 0\nv 1e8 0 0\nv 0 1 0\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::TooLarge { .. }));
+    }
+
+    #[test]
+    fn never_panics_on_mangled_input() {
+        let base = cube_obj().into_bytes();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..300 {
+            let mut b = base.clone();
+            for _ in 0..4 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let i = (state % b.len() as u64) as usize;
+                b[i] = b" /-0123456789fv\nx.e#\\"[(state >> 32) as usize % 21];
+            }
+            b.truncate(((state >> 40) as usize % b.len()).max(1));
+            let f = write("m.obj", &b);
+            let _ = load(&f.path);
+        }
+    }
+}
