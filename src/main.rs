@@ -1,3 +1,227 @@
-//! The `brickwright` command-line tool (being written).
+//! The `brickwright` command-line tool: parse, run, report.
 
-fn main() {}
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use brickwright::assembly::verify::verify;
+use brickwright::assembly::StepGrouping;
+use brickwright::grammar::{extended_alphabet, rules_text, DEFAULT_ALPHABET};
+use brickwright::pipeline::{self, BuildOptions, Progress, Silent};
+use brickwright::voxel::{Sizing, Up};
+
+/// Turn a 3D model into a LEGO build a person can assemble.
+#[derive(Parser)]
+#[command(name = "brickwright", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Build a mesh (OBJ, glTF .gltf/.glb, STL) into bricks: writes DIR/<name>.ldr and DIR/report.json.
+    Build(BuildArgs),
+    /// Check an LDraw file made of catalog parts: overlaps, connections, placeability, one piece.
+    Verify {
+        /// The .ldr or .mpd file.
+        file: PathBuf,
+    },
+    /// Write a generated rule file (the default rules, or every brick of the catalog).
+    Rules {
+        /// Which alphabet: the default seven bricks, or every brick in the catalog.
+        #[arg(long, value_enum, default_value_t = Alphabet::Default)]
+        alphabet: Alphabet,
+        /// Where to write (default: standard output).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Alphabet {
+    /// 1x1, 1x2, 1x3, 1x4, 2x2, 2x3, 2x4 bricks.
+    Default,
+    /// Every brick in the catalog (adds 1x6, 1x8, 2x6, 2x8).
+    Extended,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum UpAxis {
+    /// +Y is up (OBJ and glTF convention).
+    Y,
+    /// +Z is up (CAD and STL convention).
+    Z,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum StepBy {
+    /// A new step whenever the build moves to another layer.
+    Layer,
+}
+
+#[derive(Args)]
+struct BuildArgs {
+    /// The mesh file: .obj, .gltf, .glb or .stl.
+    input: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(short, long, default_value = "out")]
+    output: PathBuf,
+    /// Size: the model's longest horizontal side, in studs [default: 24].
+    #[arg(long, conflicts_with = "height", value_parser = clap::value_parser!(u32).range(1..=512))]
+    studs: Option<u32>,
+    /// Size: the model's height, in bricks (layers), instead of --studs.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=512))]
+    height: Option<u32>,
+    /// Which axis of the input points up.
+    #[arg(long, value_enum, default_value_t = UpAxis::Y)]
+    up: UpAxis,
+    /// Seed for the search's rule sampling: the same input, options and seed give the same files.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// A rule file (see rules/default.rules); default: the built-in default rules.
+    #[arg(long)]
+    rules: Option<PathBuf>,
+    /// Put this many pieces in each step (default: one piece a step).
+    #[arg(long, conflicts_with = "step_by", value_parser = clap::value_parser!(u32).range(1..))]
+    step_size: Option<u32>,
+    /// Group steps another way.
+    #[arg(long, value_enum)]
+    step_by: Option<StepBy>,
+    /// Give up the search after this many seconds.
+    #[arg(long, default_value_t = 120.0)]
+    time_budget: f64,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Spinners on standard error, one per stage; hidden when not a terminal.
+struct Spinners {
+    bar: std::cell::RefCell<Option<ProgressBar>>,
+}
+
+impl Progress for Spinners {
+    fn stage(&self, name: &str) {
+        let bar = ProgressBar::new_spinner();
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"),
+        );
+        bar.set_message(name.to_string());
+        bar.enable_steady_tick(Duration::from_millis(120));
+        *self.bar.borrow_mut() = Some(bar);
+    }
+    fn done(&self) {
+        if let Some(b) = self.bar.borrow_mut().take() {
+            b.finish_and_clear();
+        }
+    }
+}
+
+fn run_build(a: BuildArgs) -> Result<()> {
+    if !(a.time_budget.is_finite() && a.time_budget > 0.0) {
+        anyhow::bail!("--time-budget must be a positive number of seconds");
+    }
+    let mut opts = BuildOptions::new(&a.input);
+    opts.out_dir = a.output;
+    opts.sizing = match (a.studs, a.height) {
+        (_, Some(h)) => Sizing::Height(h),
+        (Some(s), None) => Sizing::Studs(s),
+        (None, None) => Sizing::default(),
+    };
+    opts.up = match a.up {
+        UpAxis::Y => Up::Y,
+        UpAxis::Z => Up::Z,
+    };
+    opts.rules = a.rules;
+    opts.steps = match (a.step_size, a.step_by) {
+        (Some(n), _) => StepGrouping::Size(n as usize),
+        (None, Some(StepBy::Layer)) => StepGrouping::Layer,
+        (None, None) => StepGrouping::Each,
+    };
+    opts.search = opts
+        .search
+        .with_seed(a.seed)
+        .with_time_budget(Duration::from_secs_f64(a.time_budget));
+    let spinners = Spinners {
+        bar: Default::default(),
+    };
+    let progress: &dyn Progress = if a.quiet { &Silent } else { &spinners };
+    let out = pipeline::build(&opts, progress)?;
+    if !a.quiet {
+        let r = &out.report;
+        println!(
+            "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks, verified",
+            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1], r.grid[2]
+        );
+        for p in &r.parts {
+            println!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
+        }
+        let rep = &r.repairs;
+        if !rep.is_empty() {
+            println!(
+                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels left out that no rule could join",
+                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.dropped_unbuildable
+            );
+        }
+        let s = &r.seconds;
+        println!(
+            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, write {:.2}s",
+            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.write
+        );
+    }
+    Ok(())
+}
+
+fn run_verify(file: PathBuf) -> Result<bool> {
+    let model = brickwright::ldraw::read_ldr(&file)?;
+    let asm = brickwright::ldraw::to_assembly(&model)?;
+    let report = verify(&asm, None);
+    if report.is_ok() {
+        println!(
+            "{}: OK: {} pieces, {} steps, one connected build",
+            file.display(),
+            asm.pieces.len(),
+            asm.step_count()
+        );
+        Ok(true)
+    } else {
+        println!("{}: {} problems", file.display(), report.failures.len());
+        println!("{report}");
+        Ok(false)
+    }
+}
+
+fn run_rules(alphabet: Alphabet, output: Option<PathBuf>) -> Result<()> {
+    let text = match alphabet {
+        Alphabet::Default => rules_text(&DEFAULT_ALPHABET, "default"),
+        Alphabet::Extended => rules_text(&extended_alphabet(), "extended"),
+    };
+    match output {
+        Some(p) => brickwright::fsutil::write_atomic(&p, |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("{}: cannot write", p.display()))?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Build(a) => run_build(a).map(|()| true),
+        Command::Verify { file } => run_verify(file),
+        Command::Rules { alphabet, output } => run_rules(alphabet, output).map(|()| true),
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,1 +1,431 @@
-//! (being written)
+//! The whole job: mesh file in, verified LDraw build and report out.
+//!
+//! [`build`] runs the stages in order, times each, verifies the assembly
+//! with the independent [`verify`](crate::assembly::verify) before anything
+//! is written, and writes every output atomically: a failed run leaves no
+//! file behind.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::assembly::verify::verify;
+use crate::assembly::{Assembly, StepGrouping};
+use crate::catalog::Color;
+use crate::fsutil::write_atomic;
+use crate::grammar::{default_rules_text, RuleError, RuleSet, PLATES_PER_LAYER};
+use crate::ldraw::{write_ldr, LdrMeta};
+use crate::mesh::{self, MeshError};
+use crate::search::{self, Repairs, SearchError, SearchOptions, SearchStats};
+use crate::voxel::{voxelize, Sizing, Up, VoxelizeError, VoxelizeOptions};
+
+/// Everything `brickwright build` can be told.
+#[derive(Debug, Clone, Serialize)]
+pub struct BuildOptions {
+    /// The mesh file.
+    pub input: PathBuf,
+    /// Where outputs go (created if missing). Default `out`.
+    pub out_dir: PathBuf,
+    /// Model size. Default 24 studs across.
+    #[serde(skip)]
+    pub sizing: Sizing,
+    /// The input's up axis. Default `y`.
+    #[serde(skip)]
+    pub up: Up,
+    /// A rule file; `None` for the built-in default rules.
+    pub rules: Option<PathBuf>,
+    /// Step grouping in the outputs. Default one piece a step.
+    pub steps: StepGrouping,
+    /// Search tuning, including the seed.
+    pub search: SearchOptions,
+}
+
+impl BuildOptions {
+    /// Options with defaults for `input`.
+    pub fn new(input: impl Into<PathBuf>) -> Self {
+        BuildOptions {
+            input: input.into(),
+            out_dir: PathBuf::from("out"),
+            sizing: Sizing::default(),
+            up: Up::default(),
+            rules: None,
+            steps: StepGrouping::Each,
+            search: SearchOptions::default(),
+        }
+    }
+}
+
+/// A build that could not be made. Each variant names the file at fault.
+#[derive(Debug, Error)]
+pub enum BuildError {
+    /// The mesh file is missing or bad.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The mesh cannot be voxelized at this size.
+    #[error("{file}: {source}")]
+    Voxelize {
+        /// The input file.
+        file: String,
+        /// Why.
+        source: VoxelizeError,
+    },
+    /// The rule file is bad.
+    #[error(transparent)]
+    Rules(#[from] RuleError),
+    /// The search found no build.
+    #[error("{file}: {source}")]
+    Search {
+        /// The input file.
+        file: String,
+        /// Why.
+        source: SearchError,
+    },
+    /// The verifier refused the search's build: a bug, never bad input.
+    #[error("internal error: the build of {file} failed verification ({report}); please report this with the input and options")]
+    Unverified {
+        /// The input file.
+        file: String,
+        /// What failed.
+        report: String,
+    },
+    /// An output could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// The output file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
+/// One line of the parts table.
+#[derive(Debug, Clone, Serialize)]
+pub struct PartCount {
+    /// LDraw id.
+    pub part: String,
+    /// Part name.
+    pub name: String,
+    /// How many.
+    pub count: usize,
+}
+
+/// Seconds spent in each stage.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct StageTimes {
+    /// Reading the mesh.
+    pub load: f64,
+    /// Voxelizing.
+    pub voxelize: f64,
+    /// Loading rules.
+    pub rules: f64,
+    /// The structural analysis.
+    pub search: f64,
+    /// Independent verification.
+    pub verify: f64,
+    /// Writing outputs.
+    pub write: f64,
+}
+
+/// What `report.json` holds.
+#[derive(Debug, Clone, Serialize)]
+pub struct BuildReport {
+    /// brickwright's version.
+    pub tool_version: String,
+    /// The input file as given.
+    pub input: String,
+    /// Options, as given.
+    pub options: ReportOptions,
+    /// Triangles in the input.
+    pub triangles: usize,
+    /// Grid size in studs (x, y) and layers (z).
+    pub grid: [i32; 3],
+    /// Voxels of the input after voxelization.
+    pub voxels_input: usize,
+    /// Voxels built (after repairs).
+    pub voxels: usize,
+    /// Pieces in all.
+    pub pieces: usize,
+    /// Mean voxels per piece.
+    pub voxels_per_piece: f64,
+    /// Pieces by part.
+    pub parts: Vec<PartCount>,
+    /// Connected components of the finished build (1 when verified).
+    pub components: usize,
+    /// Steps in the outputs.
+    pub steps: u32,
+    /// Size of the finished model, centimetres (x, y, height).
+    pub size_cm: [f64; 3],
+    /// Seconds per stage.
+    pub seconds: StageTimes,
+    /// Search counters.
+    pub search: SearchStats,
+    /// What had to change so the voxels could be built.
+    pub repairs: Repairs,
+    /// Files written.
+    pub outputs: Vec<String>,
+}
+
+/// The options part of the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReportOptions {
+    /// `studs N` or `height N`.
+    pub size: String,
+    /// `y` or `z`.
+    pub up: String,
+    /// Rule file, or `default`.
+    pub rules: String,
+    /// Step grouping.
+    pub steps: String,
+    /// Seed.
+    pub seed: u64,
+    /// Search budget, seconds.
+    pub time_budget: f64,
+}
+
+/// Stage callbacks, for progress display.
+pub trait Progress {
+    /// A stage starts.
+    fn stage(&self, name: &str);
+    /// The current stage ended.
+    fn done(&self);
+}
+
+/// No progress display.
+pub struct Silent;
+
+impl Progress for Silent {
+    fn stage(&self, _: &str) {}
+    fn done(&self) {}
+}
+
+/// The build and what happened.
+#[derive(Debug, Clone)]
+pub struct BuildOutput {
+    /// The verified assembly, steps grouped.
+    pub assembly: Assembly,
+    /// The report written to `report.json`.
+    pub report: BuildReport,
+}
+
+fn secs(t: Instant) -> f64 {
+    (t.elapsed().as_secs_f64() * 1000.0).round() / 1000.0
+}
+
+/// Loads the rules named in `opts`, or the built-in defaults.
+pub fn load_rules(path: Option<&Path>) -> Result<RuleSet, RuleError> {
+    match path {
+        Some(p) => RuleSet::load(p),
+        None => RuleSet::parse(
+            &default_rules_text(),
+            Path::new("rules/default.rules (built in)"),
+        ),
+    }
+}
+
+/// Runs the pipeline and writes `<stem>.ldr` and `report.json` into
+/// `opts.out_dir`.
+pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput, BuildError> {
+    let file = opts.input.display().to_string();
+    let mut times = StageTimes::default();
+
+    // Rules first: a bad rule file should fail before any slow work.
+    let t = Instant::now();
+    let rules = load_rules(opts.rules.as_deref())?;
+    times.rules = secs(t);
+
+    progress.stage("loading mesh");
+    let t = Instant::now();
+    let mesh = mesh::load(&opts.input)?;
+    times.load = secs(t);
+    progress.done();
+
+    progress.stage("voxelizing");
+    let t = Instant::now();
+    let vopts = VoxelizeOptions::default()
+        .with_sizing(opts.sizing)
+        .with_up(opts.up);
+    let model = voxelize(&mesh, &vopts).map_err(|source| BuildError::Voxelize {
+        file: file.clone(),
+        source,
+    })?;
+    times.voxelize = secs(t);
+    progress.done();
+
+    progress.stage("searching");
+    let t = Instant::now();
+    let outcome =
+        search::build(&model.grid, &rules, &opts.search).map_err(|source| BuildError::Search {
+            file: file.clone(),
+            source,
+        })?;
+    times.search = secs(t);
+    progress.done();
+
+    progress.stage("verifying");
+    let t = Instant::now();
+    let order = search::placements(&outcome);
+    let mut assembly = Assembly::from_order(&order, PLATES_PER_LAYER, Color::RED);
+    let palette = [Color::RED, Color(15)];
+    for p in &mut assembly.pieces {
+        p.color = palette[(p.placement.origin.z as usize) % palette.len()];
+    }
+    let check = verify(&assembly, Some(&outcome.voxels));
+    if !check.is_ok() {
+        return Err(BuildError::Unverified {
+            file,
+            report: check.to_string(),
+        });
+    }
+    assembly.regroup(opts.steps);
+    times.verify = secs(t);
+    progress.done();
+
+    progress.stage("writing");
+    let t = Instant::now();
+    std::fs::create_dir_all(&opts.out_dir).map_err(|source| BuildError::Write {
+        path: opts.out_dir.display().to_string(),
+        source,
+    })?;
+    let stem = opts
+        .input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".into());
+    let ldr_path = opts.out_dir.join(format!("{stem}.ldr"));
+    let report_path = opts.out_dir.join("report.json");
+    let meta = LdrMeta {
+        title: format!("{stem}, built by brickwright"),
+        name: format!("{stem}.ldr"),
+        author: "brickwright".into(),
+        notes: vec![
+            format!("brickwright {}", env!("CARGO_PKG_VERSION")),
+            format!(
+                "input: {}",
+                opts.input
+                    .file_name()
+                    .map(|s| s.to_string_lossy())
+                    .unwrap_or_default()
+            ),
+            format!("options: {}", describe(opts)),
+            format!("seed: {}", opts.search.seed),
+        ],
+    };
+    let (nx, ny, nz) = outcome.voxels.dims();
+    let mut parts: BTreeMap<String, PartCount> = BTreeMap::new();
+    for (kind, count) in assembly.counts_by_part() {
+        let spec = kind.spec();
+        parts.insert(
+            spec.id.0.to_string(),
+            PartCount {
+                part: spec.id.0.to_string(),
+                name: spec.name.to_string(),
+                count,
+            },
+        );
+    }
+    let pieces = assembly.pieces.len();
+    let voxels = outcome.voxels.count();
+    let mut report = BuildReport {
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        input: file.clone(),
+        options: ReportOptions {
+            size: match opts.sizing {
+                Sizing::Studs(n) => format!("studs {n}"),
+                Sizing::Height(n) => format!("height {n}"),
+            },
+            up: match opts.up {
+                Up::Y => "y".into(),
+                Up::Z => "z".into(),
+            },
+            rules: opts
+                .rules
+                .as_ref()
+                .map_or("default".into(), |p| p.display().to_string()),
+            steps: step_name(opts.steps),
+            seed: opts.search.seed,
+            time_budget: opts.search.time_budget.as_secs_f64(),
+        },
+        triangles: mesh.triangles.len(),
+        grid: [nx, ny, nz],
+        voxels_input: model.grid.count(),
+        voxels,
+        pieces,
+        voxels_per_piece: ((voxels as f64 / pieces.max(1) as f64) * 100.0).round() / 100.0,
+        parts: parts.into_values().collect(),
+        components: 1,
+        steps: assembly.step_count(),
+        size_cm: [
+            nx as f64 * 0.8,
+            ny as f64 * 0.8,
+            (nz as f64 * 0.96 * 100.0).round() / 100.0,
+        ],
+        seconds: times,
+        search: outcome.stats.clone(),
+        repairs: outcome.repairs.clone(),
+        outputs: vec![
+            ldr_path.display().to_string(),
+            report_path.display().to_string(),
+        ],
+    };
+    write_atomic(&ldr_path, |w| write_ldr(w, &assembly, &meta)).map_err(|source| {
+        BuildError::Write {
+            path: ldr_path.display().to_string(),
+            source,
+        }
+    })?;
+    report.seconds.write = secs(t);
+    write_atomic(&report_path, |w| {
+        serde_json::to_writer_pretty(&mut *w, &report).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })
+    .map_err(|source| BuildError::Write {
+        path: report_path.display().to_string(),
+        source,
+    })?;
+    progress.done();
+    Ok(BuildOutput { assembly, report })
+}
+
+fn step_name(s: StepGrouping) -> String {
+    match s {
+        StepGrouping::Each => "one piece a step".into(),
+        StepGrouping::Size(n) => format!("{n} pieces a step"),
+        StepGrouping::Layer => "by layer".into(),
+    }
+}
+
+/// The options as a one-line command-line echo, for file headers.
+fn describe(opts: &BuildOptions) -> String {
+    let size = match opts.sizing {
+        Sizing::Studs(n) => format!("--studs {n}"),
+        Sizing::Height(n) => format!("--height {n}"),
+    };
+    let up = match opts.up {
+        Up::Y => "y",
+        Up::Z => "z",
+    };
+    let rules = opts
+        .rules
+        .as_ref()
+        .map(|p| {
+            format!(
+                " --rules {}",
+                p.file_name()
+                    .map(|s| s.to_string_lossy())
+                    .unwrap_or_default()
+            )
+        })
+        .unwrap_or_default();
+    let steps = match opts.steps {
+        StepGrouping::Each => String::new(),
+        StepGrouping::Size(n) => format!(" --step-size {n}"),
+        StepGrouping::Layer => " --step-by layer".into(),
+    };
+    format!("{size} --up {up} --seed {}{rules}{steps}", opts.search.seed)
+}
+
+/// A default budget that is generous for a person waiting at a terminal.
+pub const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(120);

@@ -151,7 +151,13 @@ impl RuleSet {
         rules: Vec<Rule>,
         source: String,
     ) -> Result<RuleSet, RuleError> {
-        let mut set = RuleSet { alphabet, starts, rules, variants: Vec::new(), source };
+        let mut set = RuleSet {
+            alphabet,
+            starts,
+            rules,
+            variants: Vec::new(),
+            source,
+        };
         set.variants = set.generate_variants()?;
         Ok(set)
     }
@@ -316,13 +322,16 @@ mod tests {
         assert_eq!(rs.variants().len(), 1);
         assert_eq!(rs.variants()[0].weight, 4.0);
         // A 1x2 across the end of a 2x4: four distinct turns.
-        let text = "part 3001\npart 3004\nrule 3001 3004 r90 up 3 0 8\n";
+        let text = "part 3001\npart 3004\nstart 3001\nrule 3001 3004 r90 up 3 0 8\n";
         let rs = RuleSet::parse(text, "t.rules".as_ref()).unwrap();
         let v = rs.variants();
         assert_eq!(v.len(), 4);
         assert!(v.iter().all(|v| (v.weight - 2.0).abs() < 1e-12));
         // Turned a quarter, the 2x4 stands along y and the 1x2 along x.
-        let q = v.iter().find(|v| v.anchor_rot == Rot::R90 && v.offset.1 == 3).unwrap();
+        let q = v
+            .iter()
+            .find(|v| v.anchor_rot == Rot::R90 && v.offset.1 == 3)
+            .unwrap();
         assert_eq!(q.added_rot, Rot::R0);
         assert_eq!(q.offset, (0, 3, 1));
         assert_eq!(q.anchor, kind("3001"));

@@ -52,15 +52,21 @@ pub enum RuleError {
 
 impl RuleError {
     pub(super) fn at(file: &str, line: usize, message: String) -> RuleError {
-        RuleError::Line { file: file.to_string(), line, message }
+        RuleError::Line {
+            file: file.to_string(),
+            line,
+            message,
+        }
     }
 }
 
 impl RuleSet {
     /// Reads a rule file.
     pub fn load(path: &Path) -> Result<RuleSet, RuleError> {
-        let bytes = std::fs::read(path)
-            .map_err(|source| RuleError::Io { file: path.display().to_string(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| RuleError::Io {
+            file: path.display().to_string(),
+            source,
+        })?;
         let text = String::from_utf8(bytes).map_err(|e| RuleError::File {
             file: path.display().to_string(),
             message: format!(
@@ -87,13 +93,18 @@ impl RuleSet {
             let f: Vec<&str> = body.split_whitespace().collect();
             let part = |s: &str| {
                 PartKind::from_id(s).ok_or_else(|| {
-                    err(format!("unknown part `{s}`: not in brickwright's parts catalog"))
+                    err(format!(
+                        "unknown part `{s}`: not in brickwright's parts catalog"
+                    ))
                 })
             };
             match f[0] {
                 "part" => {
                     if f.len() != 2 {
-                        return Err(err(format!("`part` takes one part id, found {}", f.len() - 1)));
+                        return Err(err(format!(
+                            "`part` takes one part id, found {}",
+                            f.len() - 1
+                        )));
                     }
                     let p = part(f[1])?;
                     if alphabet.contains(&p) {
@@ -103,7 +114,10 @@ impl RuleSet {
                 }
                 "start" => {
                     if f.len() != 2 {
-                        return Err(err(format!("`start` takes one part id, found {}", f.len() - 1)));
+                        return Err(err(format!(
+                            "`start` takes one part id, found {}",
+                            f.len() - 1
+                        )));
                     }
                     let p = part(f[1])?;
                     if !alphabet.contains(&p) {
@@ -123,7 +137,10 @@ impl RuleSet {
                     let anchor = part(f[1])?;
                     let added = part(f[2])?;
                     let added_rot = Rot::parse(f[3]).ok_or_else(|| {
-                        err(format!("bad rotation `{}`: use r0, r90, r180 or r270", f[3]))
+                        err(format!(
+                            "bad rotation `{}`: use r0, r90, r180 or r270",
+                            f[3]
+                        ))
                     })?;
                     let dir = match f[4] {
                         "up" => Dir::Up,
@@ -131,7 +148,8 @@ impl RuleSet {
                         o => return Err(err(format!("bad direction `{o}`: use up or down"))),
                     };
                     let int = |s: &str, what: &str| {
-                        s.parse::<i32>().map_err(|_| err(format!("bad {what} `{s}`: not an integer")))
+                        s.parse::<i32>()
+                            .map_err(|_| err(format!("bad {what} `{s}`: not an integer")))
                     };
                     let dx = int(f[5], "dx")?;
                     let dy = int(f[6], "dy")?;
@@ -141,7 +159,16 @@ impl RuleSet {
                     if !(weight.is_finite() && weight > 0.0) {
                         return Err(err(format!("weight {} must be a positive number", f[7])));
                     }
-                    let r = Rule { anchor, added, added_rot, dir, dx, dy, weight, line };
+                    let r = Rule {
+                        anchor,
+                        added,
+                        added_rot,
+                        dir,
+                        dx,
+                        dy,
+                        weight,
+                        line,
+                    };
                     if let Some(prev) = rules.iter().find(|p| {
                         (p.anchor, p.added, p.added_rot, p.dir, p.dx, p.dy)
                             == (r.anchor, r.added, r.added_rot, r.dir, r.dx, r.dy)
@@ -158,7 +185,10 @@ impl RuleSet {
             }
         }
         if alphabet.is_empty() {
-            return Err(RuleError::File { file, message: "no `part` lines: the alphabet is empty".into() });
+            return Err(RuleError::File {
+                file,
+                message: "no `part` lines: the alphabet is empty".into(),
+            });
         }
         if starts.is_empty() {
             return Err(RuleError::File {
@@ -175,7 +205,9 @@ mod tests {
     use super::*;
 
     fn err(text: &str) -> String {
-        RuleSet::parse(text, Path::new("bad.rules")).unwrap_err().to_string()
+        RuleSet::parse(text, Path::new("bad.rules"))
+            .unwrap_err()
+            .to_string()
     }
 
     #[test]
@@ -185,23 +217,36 @@ mod tests {
             err(&format!("{head}rule 3001 3001 r0 up 9 0 1\n")),
             "bad.rules:3: the new 3001 at offset (9, 0) does not overlap the 3001 below or above it, so no stud connects them"
         );
-        assert!(err(&format!("{head}\n# c\nrule 3001 9999 r0 up 0 0 1\n")).starts_with("bad.rules:5: unknown part `9999`"));
-        assert!(err(&format!("{head}rule 3001 3001 r45 up 0 0 1\n")).contains(":3: bad rotation `r45`"));
-        assert!(err(&format!("{head}rule 3001 3001 r0 sideways 0 0 1\n")).contains(":3: bad direction"));
-        assert!(err(&format!("{head}rule 3001 3001 r0 up 0 0 -2\n")).contains(":3: weight -2 must be a positive"));
-        assert!(err(&format!("{head}rule 3001 3001 r0 up 0 0\n")).contains(":3: `rule` takes 7 fields"));
+        assert!(err(&format!("{head}\n# c\nrule 3001 9999 r0 up 0 0 1\n"))
+            .starts_with("bad.rules:5: unknown part `9999`"));
+        assert!(
+            err(&format!("{head}rule 3001 3001 r45 up 0 0 1\n")).contains(":3: bad rotation `r45`")
+        );
+        assert!(
+            err(&format!("{head}rule 3001 3001 r0 sideways 0 0 1\n")).contains(":3: bad direction")
+        );
+        assert!(err(&format!("{head}rule 3001 3001 r0 up 0 0 -2\n"))
+            .contains(":3: weight -2 must be a positive"));
+        assert!(
+            err(&format!("{head}rule 3001 3001 r0 up 0 0\n")).contains(":3: `rule` takes 7 fields")
+        );
         assert!(err(&format!("{head}rule 3001 3001 r0 up x 0 1\n")).contains(":3: bad dx `x`"));
-        assert!(err(&format!("{head}rule 3001 3001 r0 up 1 0 1\nrule 3001 3001 r0 up 1 0 2\n")).contains(":4: same rule as line 3"));
+        assert!(err(&format!(
+            "{head}rule 3001 3001 r0 up 1 0 1\nrule 3001 3001 r0 up 1 0 2\n"
+        ))
+        .contains(":4: same rule as line 3"));
         assert!(err("part 3001\nstart 3003\n").contains(":2: part 3003 is not in the alphabet"));
         assert!(err("start\n").contains(":1: `start` takes one part id"));
         assert!(err("brick 3001\n").contains(":1: unknown statement `brick`"));
         assert!(err("part 3001\n").contains("no `start` rules"));
-        assert!(err("part 3001\nstart 3001\nrule 3001 3003 r0 up 0 0 1\n").contains(":3: part 3003 is not in the alphabet"));
+        assert!(err("part 3001\nstart 3001\nrule 3001 3003 r0 up 0 0 1\n")
+            .contains(":3: part 3003 is not in the alphabet"));
     }
 
     #[test]
     fn rule_files_round_trip() {
-        let rs = RuleSet::parse(&crate::grammar::default_rules_text(), Path::new("d.rules")).unwrap();
+        let rs =
+            RuleSet::parse(&crate::grammar::default_rules_text(), Path::new("d.rules")).unwrap();
         let text = rs.to_text("round trip");
         let back = RuleSet::parse(&text, Path::new("d.rules")).unwrap();
         assert_eq!(back.alphabet(), rs.alphabet());

@@ -121,7 +121,15 @@ impl<'a> PartSearch<'a> {
             let v = &rules.variants()[i as usize];
             (v.added, v.added_rot, i)
         });
-        PartSearch { rules, opts, starts, footprints, by_shape, weights, deadline }
+        PartSearch {
+            rules,
+            opts,
+            starts,
+            footprints,
+            by_shape,
+            weights,
+            deadline,
+        }
     }
 
     /// Samples `b` distinct variants, weighted (Efraimidis–Spirakis keys),
@@ -159,7 +167,13 @@ impl<'a> PartSearch<'a> {
         (lo + (hi - lo) * done * done).round() as usize
     }
 
-    fn frame(&self, st: &State, total: usize, rng: &mut ChaCha8Rng, applied: Option<Removal>) -> Frame {
+    fn frame(
+        &self,
+        st: &State,
+        total: usize,
+        rng: &mut ChaCha8Rng,
+        applied: Option<Removal>,
+    ) -> Frame {
         let b = self.branching(st.v.count(), total);
         let (mut up, mut down) = self.sample(b, rng);
         if st.has_built() {
@@ -180,7 +194,14 @@ impl<'a> PartSearch<'a> {
     }
 
     /// Runs the backward tracing on `v` given the structure built before.
-    pub fn run(&self, v: VoxelGrid, built: &VoxelGrid, rng: &mut ChaCha8Rng, stats: &mut SearchStats) -> PartResult {
+    pub fn run(
+        &self,
+        v: VoxelGrid,
+        built: &VoxelGrid,
+        max_nodes: u64,
+        rng: &mut ChaCha8Rng,
+        stats: &mut SearchStats,
+    ) -> PartResult {
         let total = v.count();
         let orders = scan_orders(&v, !built.is_empty());
         let mut st = State::new(v, built, self.footprints.clone());
@@ -196,7 +217,8 @@ impl<'a> PartSearch<'a> {
                 stats.starts += 1;
                 return PartResult::Built(t);
             }
-            if nodes_here >= self.opts.max_nodes_per_part || (nodes_here % 256 == 0 && Instant::now() >= self.deadline) {
+            if nodes_here >= max_nodes || (nodes_here % 256 == 0 && Instant::now() >= self.deadline)
+            {
                 return PartResult::OutOfBudget;
             }
             let top = stack.last_mut().expect("root frame");
@@ -214,7 +236,8 @@ impl<'a> PartSearch<'a> {
                     stats.nodes += 1;
                     let f = self.frame(&st, total, rng, Some(removal));
                     stack.push(f);
-                    if stack.len() as u64 > stats.max_depth && std::env::var_os("BW_DUMP").is_some() {
+                    if stack.len() as u64 > stats.max_depth && std::env::var_os("BW_DUMP").is_some()
+                    {
                         eprintln!("depth {} via {:?}\n{}", stack.len(), c.piece, st.dump());
                     }
                     stats.max_depth = stats.max_depth.max(stack.len() as u64);
@@ -227,7 +250,7 @@ impl<'a> PartSearch<'a> {
                             stats.backtracks += 1;
                         }
                         None => {
-                                        return PartResult::Unbuildable;
+                            return PartResult::Unbuildable;
                         }
                     }
                 }
@@ -277,21 +300,18 @@ impl<'a> PartSearch<'a> {
                 Phase::Done => {
                     // The sampled rules found nothing: b reaches its maximum,
                     // every rule not yet tried.
-                    let tried: std::collections::HashSet<u32> = f
-                        .up
-                        .iter()
-                        .chain(&f.down)
-                        .filter_map(|s| match s {
-                            Slot::Rule(i) => Some(*i),
-                            Slot::OnBuilt(..) => None,
-                        })
-                        .collect();
+                    let tried: std::collections::HashSet<u32> =
+                        f.up.iter()
+                            .chain(&f.down)
+                            .filter_map(|s| match s {
+                                Slot::Rule(i) => Some(*i),
+                                Slot::OnBuilt(..) => None,
+                            })
+                            .collect();
                     f.up.clear();
                     f.down.clear();
+                    let _ = &tried;
                     for &i in &self.by_shape {
-                        if tried.contains(&i) {
-                            continue;
-                        }
                         match (self.rules.variants()[i as usize].dir, built) {
                             (Dir::Down, true) => f.down.push(Slot::Rule(i)),
                             _ => f.up.push(Slot::Rule(i)),
@@ -312,7 +332,11 @@ impl<'a> PartSearch<'a> {
                     f.phase = Phase::Done;
                 }
                 Phase::Up | Phase::Down => {
-                    let order = if f.phase == Phase::Up { &orders.0 } else { &orders.1 };
+                    let order = if f.phase == Phase::Up {
+                        &orders.0
+                    } else {
+                        &orders.1
+                    };
                     let slots = if f.phase == Phase::Up { &f.up } else { &f.down };
                     while f.pos < order.len() && !st.v.get(order[f.pos]) {
                         f.pos += 1;
@@ -335,6 +359,14 @@ impl<'a> PartSearch<'a> {
                         let slot = slots[f.slot];
                         f.slot += 1;
                         stats.match_tries += 1;
+                        if let (Slot::Rule(i), Some((p, r, None))) = (slot, fit) {
+                            // The new piece's shape does not fit here: skip
+                            // the other rules adding the same shape.
+                            let v = &self.rules.variants()[i as usize];
+                            if (v.added, v.added_rot) == (p, r) {
+                                continue;
+                            }
+                        }
                         if let Some(c) = self.match_at(st, slot, cell, &mut fit) {
                             if !built && !st.on_side_boundary(&c.b) {
                                 continue;
@@ -346,9 +378,9 @@ impl<'a> PartSearch<'a> {
                                 c.committed.is_some() || !st.has_committed()
                             } else {
                                 !st.any_matched
-                                || c.committed.is_some()
-                                || matches!(c.anchor_box, Some((_, Some(_))))
-                                || st.touches_matched(&c.b)
+                                    || c.committed.is_some()
+                                    || matches!(c.anchor_box, Some((_, Some(_))))
+                                    || st.touches_matched(&c.b)
                             };
                             if !connected {
                                 if f.deferred.len() < 256 {
@@ -385,7 +417,11 @@ impl<'a> PartSearch<'a> {
                 let committed = match *fit {
                     Some((p, r, c)) if (p, r) == (v.added, v.added_rot) => c,
                     _ => {
-                        let c = if st.v.all_set(&b) { st.commitment(&b, &piece) } else { None };
+                        let c = if st.v.all_set(&b) {
+                            st.commitment(&b, &piece)
+                        } else {
+                            None
+                        };
                         *fit = Some((v.added, v.added_rot, c));
                         c
                     }
@@ -414,7 +450,14 @@ impl<'a> PartSearch<'a> {
                     return None;
                 }
                 let committed = st.commitment(&b, &piece)?;
-                Some(Candidate { piece, b, committed, anchor: Anchor::Built, anchor_box: None, rule: None })
+                Some(Candidate {
+                    piece,
+                    b,
+                    committed,
+                    anchor: Anchor::Built,
+                    anchor_box: None,
+                    rule: None,
+                })
             }
         }
     }
@@ -422,7 +465,14 @@ impl<'a> PartSearch<'a> {
     /// The checks that need the removal applied: placeability and
     /// connectivity. Leaves the state unchanged.
     fn passes(&self, st: &mut State, c: &Candidate, stats: &mut SearchStats) -> bool {
-        let r = st.apply(c.piece, &c.b, c.committed, c.anchor, c.anchor_box.as_ref().map(|(b, id)| (b, *id)), c.rule);
+        let r = st.apply(
+            c.piece,
+            &c.b,
+            c.committed,
+            c.anchor,
+            c.anchor_box.as_ref().map(|(b, id)| (b, *id)),
+            c.rule,
+        );
         let new_anchor = match c.anchor_box {
             Some((ab, None)) => Some(ab),
             _ => None,
@@ -441,7 +491,6 @@ impl<'a> PartSearch<'a> {
         ok
     }
 }
-
 
 /// The cell orders the scans follow. With a structure built below, up rules
 /// scan from the top layer down and down rules from the bottom up, each layer

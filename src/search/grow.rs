@@ -34,12 +34,18 @@ struct Frame {
     slot: usize,
     corner: usize,
     widened: bool,
+    /// Whether the look-ahead was switched off after every rule failed.
+    relaxed: bool,
     placed: bool,
 }
 
-/// Grows a build of `v` forward from a starting piece near its middle.
+/// Grows a build of `v` forward: from a starting piece near the middle of
+/// its lowest layer when nothing is built yet, otherwise from the pieces
+/// that rest on `built`, the structure built before. Voxels that no rule can
+/// join after `max_backtracks_per_part` backtracks are left out of `v`.
 pub(crate) fn grow(
-    v: &VoxelGrid,
+    v: &mut VoxelGrid,
+    built: &VoxelGrid,
     rules: &RuleSet,
     opts: &SearchOptions,
     deadline: Instant,
@@ -51,21 +57,31 @@ pub(crate) fn grow(
     };
     let (nx, ny, nz) = v.dims();
     let total = v.count();
-    // Seed cell: the cell of the lowest layer nearest the middle.
-    let (cx, cy) = (2 * bounds.min.x + bounds.sx - 1, 2 * bounds.min.y + bounds.sy - 1);
-    let seed = v
-        .layer_cells(bounds.min.z)
-        .min_by_key(|c| {
-            let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
-            (dx * dx + dy * dy, c.y, c.x)
-        })
-        .expect("non-empty bottom layer");
-    let dist = distances(v, seed);
+    let mut backtracks_here = 0u64;
+    let on_built = |c: Cell| built.get(c.offset(0, 0, -1)) || built.get(c.offset(0, 0, 1));
+    // Growth starts next to the built structure, or in the middle of the
+    // lowest layer.
+    let (cx, cy) = (
+        2 * bounds.min.x + bounds.sx - 1,
+        2 * bounds.min.y + bounds.sy - 1,
+    );
+    let seeds: Vec<Cell> = if built.is_empty() {
+        let seed = v
+            .layer_cells(bounds.min.z)
+            .min_by_key(|c| {
+                let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
+                (dx * dx + dy * dy, c.y, c.x)
+            })
+            .expect("non-empty bottom layer");
+        vec![seed]
+    } else {
+        v.cells().filter(|&c| on_built(c)).collect()
+    };
+    let dist = distances(v, &seeds);
     let mut cover = VoxelGrid::new(nx, ny, nz);
     let mut owner = vec![NONE; v.len()];
     let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
 
-    // The start: the biggest starting piece over the seed that fits.
     let mut starts: Vec<(crate::catalog::PartKind, Rot)> = Vec::new();
     for s in rules.starts() {
         for rot in [Rot::R0, Rot::R90] {
@@ -76,39 +92,53 @@ pub(crate) fn grow(
         }
     }
     starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
-    let mut first = None;
-    'outer: for &(part, rot) in &starts {
-        let (sx, sy) = part.spec().footprint(rot);
-        for oy in 0..sy {
-            for ox in 0..sx {
-                let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
-                if v.all_set(&boxed(&p)) {
-                    first = Some(p);
-                    break 'outer;
-                }
-            }
-        }
-    }
-    let Some(first) = first else {
-        return PartResult::Unbuildable;
-    };
     let place = |p: &Placement, cover: &mut VoxelGrid, owner: &mut Vec<u32>, id: u32| {
         let b = boxed(p);
         cover.set_box(&b, true);
         for c in b.cells() {
-            owner[v.index(c)] = id;
+            let i = cover.index(c);
+            owner[i] = id;
         }
     };
-    place(&first, &mut cover, &mut owner, 0);
-    placed.push((first, Anchor::Start, None));
-    stats.starts += 1;
-
+    if built.is_empty() {
+        // The starting rule: the biggest starting piece over the seed.
+        let seed = seeds[0];
+        let mut first = None;
+        'outer: for &(part, rot) in &starts {
+            let (sx, sy) = part.spec().footprint(rot);
+            for oy in 0..sy {
+                for ox in 0..sx {
+                    let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
+                    if v.all_set(&boxed(&p)) {
+                        first = Some(p);
+                        break 'outer;
+                    }
+                }
+            }
+        }
+        let Some(first) = first else {
+            return PartResult::Unbuildable;
+        };
+        place(&first, &mut cover, &mut owner, 0);
+        placed.push((first, Anchor::Start, None));
+        stats.starts += 1;
+    }
+    let n_rules = rules.variants().len() as u32;
     let weights: Vec<f64> = rules.variants().iter().map(|x| x.weight).collect();
-    let mut by_shape: Vec<u32> = (0..weights.len() as u32).collect();
+    let mut by_shape: Vec<u32> = (0..n_rules).collect();
     by_shape.sort_by_key(|&i| {
         let x = &rules.variants()[i as usize];
-        (std::cmp::Reverse(x.added.spec().studs()), x.added, x.added_rot, i)
+        (
+            std::cmp::Reverse(x.added.spec().studs()),
+            x.added,
+            x.added_rot,
+            i,
+        )
     });
+    // Slots past the rules are starting pieces resting on the built part.
+    if !built.is_empty() {
+        by_shape.extend((0..starts.len() as u32).map(|k| n_rules + k));
+    }
     let mut shapes: Vec<(i32, i32)> = Vec::new();
     for p in rules.alphabet() {
         for rot in [Rot::R0, Rot::R90] {
@@ -122,80 +152,127 @@ pub(crate) fn grow(
     let mut stack: Vec<Frame> = Vec::new();
     let mut nodes = 0u64;
     loop {
-        let left = total - cover.count();
+        let left = v.count() - cover.count();
         if left == 0 {
-            let trace = placed.iter().rev().map(|&(p, a, r)| Removal::forward(p, a, r)).collect();
+            let trace = placed
+                .iter()
+                .rev()
+                .map(|&(p, a, r)| Removal::forward(p, a, r))
+                .collect();
             return PartResult::Built(trace);
         }
-        if nodes >= opts.max_nodes_per_part || (nodes % 256 == 0 && Instant::now() >= deadline) {
+        if nodes % 256 == 0 && Instant::now() >= deadline {
             return PartResult::OutOfBudget;
         }
-        // The frame for the current state, if not yet made.
         if stack.last().is_none_or(|f| f.placed) {
-            let target = nearest_uncovered(v, &cover, &dist);
+            let target = nearest_uncovered(v, &cover, built, &dist);
             let done = 1.0 - left as f64 / total as f64;
             let b = (opts.b_min as f64 + (opts.b_max - opts.b_min) as f64 * done * done) as usize;
-            let slots = sample(&weights, b, rng);
-            stack.push(Frame { target, slots, slot: 0, corner: 0, widened: false, placed: false });
+            let mut slots = sample(&weights, b, rng);
+            if !built.is_empty() && on_built(target) {
+                slots.extend((0..starts.len() as u32).map(|k| n_rules + k));
+            }
+            stack.push(Frame {
+                target,
+                slots,
+                slot: 0,
+                corner: 0,
+                widened: false,
+                relaxed: false,
+                placed: false,
+            });
         }
         let f = stack.last_mut().expect("frame");
-        let mut found: Option<(Placement, Placement, u32)> = None;
+        let mut found: Option<(Placement, Anchor, Option<u32>)> = None;
         'scan: loop {
             while f.slot < f.slots.len() {
-                let vi = f.slots[f.slot];
-                let var = &rules.variants()[vi as usize];
-                let (sx, sy) = var.added.spec().footprint(var.added_rot);
+                let si = f.slots[f.slot];
+                let (added, added_rot) = if si < n_rules {
+                    let x = &rules.variants()[si as usize];
+                    (x.added, x.added_rot)
+                } else {
+                    starts[(si - n_rules) as usize]
+                };
+                let (sx, sy) = added.spec().footprint(added_rot);
                 while f.corner < (sx * sy) as usize {
                     let (ox, oy) = (f.corner as i32 % sx, f.corner as i32 / sx);
                     f.corner += 1;
                     stats.match_tries += 1;
-                    let p = Placement::new(var.added, f.target.offset(-ox, -oy, 0), var.added_rot);
+                    let p = Placement::new(added, f.target.offset(-ox, -oy, 0), added_rot);
                     let b = boxed(&p);
                     if !v.all_set(&b) || cover.any_set(&b) {
                         continue;
                     }
-                    let (dx, dy, dz) = var.offset;
-                    let a = Placement::new(var.anchor, p.origin.offset(-dx, -dy, -dz), var.anchor_rot);
-                    let a_box = boxed(&a);
-                    if !cover.in_bounds(a.origin) {
-                        continue;
-                    }
-                    let id = owner[v.index(a.origin)];
-                    if id == NONE || placed[id as usize].0 != a || !cover.all_set(&a_box) {
-                        continue;
-                    }
-                    if !placeable(&cover, &b) {
+                    let anchor = if si < n_rules {
+                        let x = &rules.variants()[si as usize];
+                        let (dx, dy, dz) = x.offset;
+                        let a =
+                            Placement::new(x.anchor, p.origin.offset(-dx, -dy, -dz), x.anchor_rot);
+                        if !cover.in_bounds(a.origin) {
+                            continue;
+                        }
+                        let id = owner[v.index(a.origin)];
+                        if id == NONE || placed[id as usize].0 != a {
+                            continue;
+                        }
+                        Anchor::Piece(a)
+                    } else {
+                        if !b.cells().any(on_built) {
+                            continue;
+                        }
+                        Anchor::Built
+                    };
+                    if !placeable(&cover, built, &b) {
                         stats.rejected_placeable += 1;
                         continue;
                     }
                     cover.set_box(&b, true);
-                    let ok = still_coverable(v, &cover, &b, &shapes);
+                    let ok = f.relaxed || still_coverable(v, &cover, built, &b, &shapes);
                     cover.set_box(&b, false);
                     if !ok {
                         stats.rejected_reach += 1;
                         continue;
                     }
-                    found = Some((p, a, var.rule.0));
+                    found = Some((
+                        p,
+                        anchor,
+                        (si < n_rules).then(|| rules.variants()[si as usize].rule.0),
+                    ));
                     break 'scan;
                 }
                 f.slot += 1;
                 f.corner = 0;
             }
-            if f.widened {
+            if f.widened && (f.relaxed || backtracks_here < opts.max_backtracks_per_part) {
                 break;
             }
+            if f.widened {
+                // Past the backtracking budget: cover the voxel even if that
+                // strands a neighbour, rather than leave this one out.
+                f.relaxed = true;
+                f.slot = 0;
+                f.corner = 0;
+                continue;
+            }
             let tried: std::collections::HashSet<u32> = f.slots.iter().copied().collect();
-            f.slots = by_shape.iter().copied().filter(|i| !tried.contains(i)).collect();
+            f.slots = by_shape
+                .iter()
+                .copied()
+                .filter(|i| !tried.contains(i))
+                .collect();
             f.slot = 0;
             f.corner = 0;
             f.widened = true;
             stats.widened += 1;
         }
         match found {
-            Some((p, a, rule)) => {
+            Some((p, anchor, rule)) => {
                 let id = placed.len() as u32;
                 place(&p, &mut cover, &mut owner, id);
-                placed.push((p, Anchor::Piece(a), Some(crate::grammar::RuleId(rule))));
+                placed.push((p, anchor, rule.map(crate::grammar::RuleId)));
+                if anchor == Anchor::Built {
+                    stats.starts += 1;
+                }
                 f.placed = true;
                 nodes += 1;
                 stats.nodes += 1;
@@ -203,51 +280,71 @@ pub(crate) fn grow(
                 // The child frame is made on the next turn.
             }
             None => {
-                if std::env::var_os("BW_DUMP").is_some() && stats.backtracks == 0 {
-                    let (nx, ny, nz) = v.dims();
-                    eprintln!("dead end at target {:?}", f.target);
-                    for z in (0..nz).rev() {
-                        for y in 0..ny {
-                            let row: String = (0..nx)
-                                .map(|x| {
-                                    let c = Cell::new(x, y, z);
-                                    if !v.get(c) { ' ' } else if cover.get(c) {
-                                        (b'a' + (owner[v.index(c)] % 26) as u8) as char
-                                    } else { '.' }
-                                })
-                                .collect();
-                            eprintln!("{row}");
-                        }
-                        eprintln!();
+                if backtracks_here >= opts.max_backtracks_per_part || placed.is_empty() {
+                    // Repair: this voxel cannot be joined to the build in any
+                    // way tried; leave it out and go on from here.
+                    let t = f.target;
+                    if std::env::var_os("BW_DEBUG").is_some() {
+                        eprintln!(
+                            "drop {t:?}: on built {}, covered above {}, below {}, in v above {} below {}, slots {} widened {}",
+                            on_built(t),
+                            cover.get(t.offset(0, 0, 1)),
+                            cover.get(t.offset(0, 0, -1)),
+                            v.get(t.offset(0, 0, 1)),
+                            v.get(t.offset(0, 0, -1)),
+                            f.slots.len(),
+                            f.widened
+                        );
                     }
+                    v.set(t, false);
+                    stats.dropped_unbuildable += 1;
+                    stack.pop();
+                    continue;
                 }
                 // Dead end: undo the piece that led here and try its next option.
                 stack.pop();
                 stats.backtracks += 1;
-                let Some(parent) = stack.last_mut() else {
-                    return PartResult::Unbuildable;
-                };
+                backtracks_here += 1;
                 let (p, _, _) = placed.pop().expect("a placed piece per frame");
                 let b = boxed(&p);
                 cover.set_box(&b, false);
                 for c in b.cells() {
                     owner[v.index(c)] = NONE;
                 }
-                parent.placed = false;
+                match stack.last_mut() {
+                    Some(parent) => parent.placed = false,
+                    None => {
+                        // The piece came from the root frame of a part on a
+                        // built structure: there is no parent frame.
+                        if !built.is_empty() {
+                            continue;
+                        }
+                        return PartResult::Unbuildable;
+                    }
+                }
             }
         }
     }
 }
 
 /// Breadth-first distances from `seed` through face-adjacent voxels.
-fn distances(v: &VoxelGrid, seed: Cell) -> Vec<u32> {
+fn distances(v: &VoxelGrid, seeds: &[Cell]) -> Vec<u32> {
     let mut d = vec![u32::MAX; v.len()];
     let mut q = std::collections::VecDeque::new();
-    d[v.index(seed)] = 0;
-    q.push_back(seed);
+    for &s in seeds {
+        d[v.index(s)] = 0;
+        q.push_back(s);
+    }
     while let Some(c) = q.pop_front() {
         let dc = d[v.index(c)];
-        for n in [c.offset(1, 0, 0), c.offset(-1, 0, 0), c.offset(0, 1, 0), c.offset(0, -1, 0), c.offset(0, 0, 1), c.offset(0, 0, -1)] {
+        for n in [
+            c.offset(1, 0, 0),
+            c.offset(-1, 0, 0),
+            c.offset(0, 1, 0),
+            c.offset(0, -1, 0),
+            c.offset(0, 0, 1),
+            c.offset(0, 0, -1),
+        ] {
             if v.get(n) && d[v.index(n)] == u32::MAX {
                 d[v.index(n)] = dc + 1;
                 q.push_back(n);
@@ -257,15 +354,26 @@ fn distances(v: &VoxelGrid, seed: Cell) -> Vec<u32> {
     d
 }
 
-/// The next voxel to cover: the nearest to the start among those with a
-/// placed piece directly above or below (so some piece over it connects),
-/// else the nearest of all.
-fn nearest_uncovered(v: &VoxelGrid, cover: &VoxelGrid, dist: &[u32]) -> Cell {
+/// The next voxel to cover: among those with a placed piece directly above
+/// or below (so some piece over it connects), the lowest, then the nearest to
+/// the start; else the nearest of all.
+fn nearest_uncovered(v: &VoxelGrid, cover: &VoxelGrid, built: &VoxelGrid, dist: &[u32]) -> Cell {
     v.cells()
         .filter(|&c| !cover.get(c))
         .min_by_key(|&c| {
-            let supported = cover.get(c.offset(0, 0, 1)) || cover.get(c.offset(0, 0, -1));
-            (!supported, dist[v.index(c)], std::cmp::Reverse(c.z), c.y, c.x)
+            let (up, down) = (c.offset(0, 0, 1), c.offset(0, 0, -1));
+            let supported = cover.get(up) || cover.get(down) || built.get(up) || built.get(down);
+            // Resting on a built part, the build goes up layer by layer, so
+            // no voxel is shut in between pieces above and below it.
+            let layer = if built.is_empty() { 0 } else { c.z };
+            (
+                !supported,
+                layer,
+                dist[v.index(c)],
+                std::cmp::Reverse(c.z),
+                c.y,
+                c.x,
+            )
         })
         .expect("an uncovered voxel")
 }
@@ -286,12 +394,21 @@ fn sample(weights: &[f64], b: usize, rng: &mut ChaCha8Rng) -> Vec<u32> {
 }
 
 /// Pressed straight down or straight up through cells not yet built.
-fn placeable(cover: &VoxelGrid, b: &CellBox) -> bool {
+fn placeable(cover: &VoxelGrid, built: &VoxelGrid, b: &CellBox) -> bool {
     let (_, _, nz) = cover.dims();
     let top = b.min.z + b.sz;
-    let above = CellBox { min: b.min.offset(0, 0, b.sz), sz: (nz - top).max(1), ..*b };
-    let below = CellBox { min: Cell::new(b.min.x, b.min.y, 0), sz: b.min.z.max(1), ..*b };
-    top >= nz || !cover.any_set(&above) || b.min.z == 0 || !cover.any_set(&below)
+    let above = CellBox {
+        min: b.min.offset(0, 0, b.sz),
+        sz: (nz - top).max(1),
+        ..*b
+    };
+    let below = CellBox {
+        min: Cell::new(b.min.x, b.min.y, 0),
+        sz: b.min.z.max(1),
+        ..*b
+    };
+    let blocked = |bx: &CellBox| cover.any_set(bx) || built.any_set(bx);
+    top >= nz || !blocked(&above) || b.min.z == 0 || !blocked(&below)
 }
 
 /// Whether every uncovered voxel near `b` can still be covered in some
@@ -299,8 +416,19 @@ fn placeable(cover: &VoxelGrid, b: &CellBox) -> bool {
 /// uncovered voxels, has a voxel directly above or below that is covered,
 /// or can itself be covered first (a fixpoint over a window around `b`;
 /// voxels outside the window are assumed coverable).
-fn still_coverable(v: &VoxelGrid, cover: &VoxelGrid, b: &CellBox, shapes: &[(i32, i32)]) -> bool {
-    let w = CellBox { min: b.min.offset(-4, -4, -2), sx: b.sx + 8, sy: b.sy + 8, sz: b.sz + 4 };
+fn still_coverable(
+    v: &VoxelGrid,
+    cover: &VoxelGrid,
+    built: &VoxelGrid,
+    b: &CellBox,
+    shapes: &[(i32, i32)],
+) -> bool {
+    let w = CellBox {
+        min: b.min.offset(-4, -4, -2),
+        sx: b.sx + 8,
+        sy: b.sy + 8,
+        sz: b.sz + 4,
+    };
     let cells: Vec<Cell> = w.cells().filter(|&c| v.get(c) && !cover.get(c)).collect();
     if cells.is_empty() {
         return true;
@@ -315,12 +443,22 @@ fn still_coverable(v: &VoxelGrid, cover: &VoxelGrid, b: &CellBox, shapes: &[(i32
     loop {
         let before = pending.len();
         pending.retain(|&u| {
-            let support = |c: Cell| v.get(c) && (cover.get(c) || !w.contains(c) || ok[local(c)]);
+            let support = |c: Cell| {
+                built.get(c) || (v.get(c) && (cover.get(c) || !w.contains(c) || ok[local(c)]))
+            };
             let coverable = shapes.iter().any(|&(sx, sy)| {
                 (0..sy).any(|oy| {
                     (0..sx).any(|ox| {
-                        let bx = CellBox { min: u.offset(-ox, -oy, 0), sx, sy, sz: 1 };
-                        free(&bx) && bx.cells().any(|c| support(c.offset(0, 0, -1)) || support(c.offset(0, 0, 1)))
+                        let bx = CellBox {
+                            min: u.offset(-ox, -oy, 0),
+                            sx,
+                            sy,
+                            sz: 1,
+                        };
+                        free(&bx)
+                            && bx
+                                .cells()
+                                .any(|c| support(c.offset(0, 0, -1)) || support(c.offset(0, 0, 1)))
                     })
                 })
             });

@@ -24,6 +24,8 @@ pub struct Repairs {
     pub supported_islands: usize,
     /// Voxels added as supports.
     pub support_voxels: usize,
+    /// Voxels left out because no rule could join them to the build.
+    pub dropped_unbuildable: usize,
 }
 
 impl Repairs {
@@ -201,7 +203,11 @@ pub fn split_parts(v: &VoxelGrid, max_layers: i32) -> Vec<VoxelGrid> {
         }
         g
     };
-    let mut parts: Vec<(i32, i32)> = cuts.windows(2).map(|w| (w[0], w[1])).filter(|w| w.0 < w.1).collect();
+    let mut parts: Vec<(i32, i32)> = cuts
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .filter(|w| w.0 < w.1)
+        .collect();
     let mut k = 0;
     while k < parts.len() {
         let (lo, hi) = parts[k];
@@ -210,7 +216,9 @@ pub fn split_parts(v: &VoxelGrid, max_layers: i32) -> Vec<VoxelGrid> {
         let ok = if k == 0 {
             comps.len() <= 1
         } else {
-            comps.iter().all(|comp| comp.iter().any(|c| c.z == lo && v.get(c.offset(0, 0, -1))))
+            comps
+                .iter()
+                .all(|comp| comp.iter().any(|c| c.z == lo && v.get(c.offset(0, 0, -1))))
         };
         if ok || k + 1 == parts.len() {
             k += 1;
@@ -219,7 +227,11 @@ pub fn split_parts(v: &VoxelGrid, max_layers: i32) -> Vec<VoxelGrid> {
             parts.remove(k + 1);
         }
     }
-    parts.into_iter().map(|(lo, hi)| slab(lo, hi)).collect()
+    parts
+        .into_iter()
+        .map(|(lo, hi)| slab(lo, hi))
+        .filter(|g| !g.is_empty())
+        .collect()
 }
 
 #[cfg(test)]
@@ -237,9 +249,24 @@ mod tests {
 
     #[test]
     fn floating_island_gets_a_support_and_specks_are_dropped() {
-        let base = CellBox { min: Cell::new(0, 0, 0), sx: 6, sy: 6, sz: 2 };
-        let island = CellBox { min: Cell::new(1, 1, 5), sx: 3, sy: 3, sz: 2 };
-        let speck = CellBox { min: Cell::new(10, 10, 10), sx: 1, sy: 1, sz: 1 };
+        let base = CellBox {
+            min: Cell::new(0, 0, 0),
+            sx: 6,
+            sy: 6,
+            sz: 2,
+        };
+        let island = CellBox {
+            min: Cell::new(1, 1, 5),
+            sx: 3,
+            sy: 3,
+            sz: 2,
+        };
+        let speck = CellBox {
+            min: Cell::new(10, 10, 10),
+            sx: 1,
+            sy: 1,
+            sz: 1,
+        };
         let g = grid_with(&[base, island, speck]);
         let (fixed, rep) = repair_islands(&g);
         assert_eq!(rep.dropped_islands, 1);
@@ -254,17 +281,42 @@ mod tests {
     fn parts_cut_where_the_count_changes_and_merge_when_they_cannot_rest() {
         // A wide base, a narrow tower: cut between them.
         let g = grid_with(&[
-            CellBox { min: Cell::new(0, 0, 0), sx: 8, sy: 8, sz: 3 },
-            CellBox { min: Cell::new(2, 2, 3), sx: 2, sy: 2, sz: 5 },
+            CellBox {
+                min: Cell::new(0, 0, 0),
+                sx: 8,
+                sy: 8,
+                sz: 3,
+            },
+            CellBox {
+                min: Cell::new(2, 2, 3),
+                sx: 2,
+                sy: 2,
+                sz: 5,
+            },
         ]);
         let parts = split_parts(&g, 6);
         let counts: Vec<usize> = parts.iter().map(|p| p.count()).collect();
-        assert_eq!(counts, vec![8 * 8 * 2, 8 * 8, 2 * 2 * 5]);
+        assert_eq!(counts, vec![8 * 8 * 2, 8 * 8 + 2 * 2 * 5]);
         // Two legs and a top: the legs part is not one piece, so it merges.
         let t = grid_with(&[
-            CellBox { min: Cell::new(0, 0, 0), sx: 1, sy: 1, sz: 3 },
-            CellBox { min: Cell::new(6, 0, 0), sx: 1, sy: 1, sz: 3 },
-            CellBox { min: Cell::new(0, 0, 3), sx: 7, sy: 3, sz: 1 },
+            CellBox {
+                min: Cell::new(0, 0, 0),
+                sx: 1,
+                sy: 1,
+                sz: 3,
+            },
+            CellBox {
+                min: Cell::new(6, 0, 0),
+                sx: 1,
+                sy: 1,
+                sz: 3,
+            },
+            CellBox {
+                min: Cell::new(0, 0, 3),
+                sx: 7,
+                sy: 3,
+                sz: 1,
+            },
         ]);
         let parts = split_parts(&t, 6);
         assert_eq!(parts.len(), 1);

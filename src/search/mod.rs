@@ -38,10 +38,12 @@ pub struct SearchOptions {
     /// Branching factor as the voxels left go to zero (paper: 100-200).
     /// Default 160.
     pub b_max: usize,
-    /// Nodes one attempt at a part may expand before it restarts. Default 200,000.
+    /// Nodes the backward tracing of a part may expand before the part is
+    /// generated forward instead. Default 20,000.
     pub max_nodes_per_part: u64,
-    /// Restarts of a part, with fresh samples, before parts are merged. Default 3.
-    pub restarts: u32,
+    /// Backtracks the forward growth of the bottom part may make before it
+    /// leaves out a voxel it cannot join. Default 256.
+    pub max_backtracks_per_part: u64,
     /// Layers a part may have before the hierarchy cuts it anyway. Default 6.
     pub max_part_layers: i32,
     /// Wall-clock budget for the whole search. Default 120 s.
@@ -54,8 +56,8 @@ impl Default for SearchOptions {
             seed: 1,
             b_min: 16,
             b_max: 160,
-            max_nodes_per_part: 200_000,
-            restarts: 3,
+            max_nodes_per_part: 20_000,
+            max_backtracks_per_part: 256,
             max_part_layers: 6,
             time_budget: Duration::from_secs(120),
         }
@@ -95,16 +97,16 @@ pub struct SearchStats {
     pub max_depth: u64,
     /// Starting rules applied.
     pub starts: u64,
-    /// Part attempts restarted after running out of nodes.
-    pub restarts: u64,
-    /// Parts merged with the part above after failing.
-    pub merges: u64,
+    /// Parts whose backward tracing ran out of nodes and that were then
+    /// generated forward.
+    pub fallbacks: u64,
     /// Nodes whose sampled rules found nothing, widened to every rule.
     pub widened: u64,
+    /// Voxels left out because no rule could join them to the build.
+    pub dropped_unbuildable: u64,
     /// Parts the hierarchy cut the model into (after merges).
     pub parts: u64,
 }
-
 
 /// A search that could not produce a build.
 #[derive(Debug, Error)]
@@ -140,7 +142,11 @@ pub struct SearchOutcome {
 }
 
 /// Finds an ordered, connected build of `voxels` with the rules `rules`.
-pub fn build(voxels: &VoxelGrid, rules: &RuleSet, opts: &SearchOptions) -> Result<SearchOutcome, SearchError> {
+pub fn build(
+    voxels: &VoxelGrid,
+    rules: &RuleSet,
+    opts: &SearchOptions,
+) -> Result<SearchOutcome, SearchError> {
     if voxels.is_empty() {
         return Err(SearchError::Empty);
     }
@@ -154,63 +160,59 @@ pub fn build(voxels: &VoxelGrid, rules: &RuleSet, opts: &SearchOptions) -> Resul
     let mut order: Vec<Removal> = Vec::new();
     let search = PartSearch::new(rules, opts, deadline);
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    let mut i = 0;
-    while i < parts.len() {
-        let mut done = None;
-        for attempt in 0..=opts.restarts {
-            if attempt > 0 {
-                stats.restarts += 1;
-            }
-            let result = if built.is_empty() {
-                grow::grow(&parts[i], rules, opts, deadline, &mut rng, &mut stats)
-            } else {
-                search.run(parts[i].clone(), &built, &mut rng, &mut stats)
-            };
-            match result {
-                PartResult::Built(trace) => {
-                    done = Some(trace);
-                    break;
+    for (i, part) in parts.iter_mut().enumerate() {
+        let result = if built.is_empty() {
+            grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
+        } else {
+            let budget = (2 * part.count() as u64 + 1000).min(opts.max_nodes_per_part);
+            match search.run(part.clone(), &built, budget, &mut rng, &mut stats) {
+                PartResult::Built(t) => PartResult::Built(t),
+                _ if Instant::now() < deadline => {
+                    stats.fallbacks += 1;
+                    grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
                 }
-                PartResult::Unbuildable => break,
-                PartResult::OutOfBudget => {
-                    if Instant::now() >= deadline {
-                        break;
-                    }
-                }
+                other => other,
             }
+        };
+        if std::env::var_os("BW_DEBUG").is_some() {
+            eprintln!(
+                "part {i}: {} voxels, {:?}, {} built below: {}",
+                part.count(),
+                part.bounds(),
+                built.count(),
+                match &result {
+                    PartResult::Built(t) => format!("built {}", t.len()),
+                    PartResult::Unbuildable => "unbuildable".into(),
+                    PartResult::OutOfBudget => "out of budget".into(),
+                }
+            );
         }
-        match done {
-            Some(trace) => {
+        match result {
+            PartResult::Built(trace) => {
                 for r in trace.iter().rev() {
                     built.set_box(&r.piece.cells_box(crate::grammar::PLATES_PER_LAYER), true);
                     order.push(*r);
                 }
-                i += 1;
             }
-            None if i + 1 < parts.len() && Instant::now() < deadline => {
-                let next = parts.remove(i + 1);
-                merge_into(&mut parts[i], &next);
-                stats.merges += 1;
-            }
-            None => {
-                let left = parts[i..].iter().map(|p| p.count()).sum();
+            PartResult::Unbuildable | PartResult::OutOfBudget => {
                 return Err(SearchError::Budget {
                     nodes: stats.nodes,
                     secs: started.elapsed().as_secs_f64(),
-                    left,
+                    left: fixed.count() - built.count(),
                     total: fixed.count(),
                 });
             }
         }
     }
     stats.parts = parts.len() as u64;
-    Ok(SearchOutcome { order, voxels: fixed, repairs, stats })
-}
-
-fn merge_into(a: &mut VoxelGrid, b: &VoxelGrid) {
-    for c in b.cells().collect::<Vec<_>>() {
-        a.set(c, true);
-    }
+    let mut repairs = repairs;
+    repairs.dropped_unbuildable = fixed.count() - built.count();
+    Ok(SearchOutcome {
+        order,
+        voxels: built,
+        repairs,
+        stats,
+    })
 }
 
 /// The pieces of an outcome in build order.
@@ -237,29 +239,48 @@ mod tests {
     }
 
     fn bx(x: i32, y: i32, z: i32, sx: i32, sy: i32, sz: i32) -> CellBox {
-        CellBox { min: Cell::new(x, y, z), sx, sy, sz }
+        CellBox {
+            min: Cell::new(x, y, z),
+            sx,
+            sy,
+            sz,
+        }
     }
 
     /// Cover, no overlap, each piece connected to an earlier one.
     fn check(out: &SearchOutcome) {
         let (nx, ny, nz) = out.voxels.dims();
         let mut seen = VoxelGrid::new(nx, ny, nz);
-        let boxes: Vec<CellBox> = out.order.iter().map(|r| r.piece.cells_box(PLATES_PER_LAYER)).collect();
+        let boxes: Vec<CellBox> = out
+            .order
+            .iter()
+            .map(|r| r.piece.cells_box(PLATES_PER_LAYER))
+            .collect();
         for (i, b) in boxes.iter().enumerate() {
             assert!(!seen.any_set(b), "piece {i} overlaps");
             seen.set_box(b, true);
             if i > 0 {
                 let ok = boxes[..i].iter().any(|a| {
-                    a.footprints_overlap(b) && (a.min.z + a.sz == b.min.z || b.min.z + b.sz == a.min.z)
+                    a.footprints_overlap(b)
+                        && (a.min.z + a.sz == b.min.z || b.min.z + b.sz == a.min.z)
                 });
-                assert!(ok, "piece {i} {:?} not connected to an earlier one", out.order[i]);
+                assert!(
+                    ok,
+                    "piece {i} {:?} not connected to an earlier one",
+                    out.order[i]
+                );
             }
         }
         assert_eq!(seen, out.voxels);
     }
 
     fn run(g: &VoxelGrid) -> SearchOutcome {
-        let out = build(g, &rules(), &SearchOptions::default().with_time_budget(Duration::from_secs(20))).unwrap();
+        let out = build(
+            g,
+            &rules(),
+            &SearchOptions::default().with_time_budget(Duration::from_secs(20)),
+        )
+        .unwrap();
         eprintln!("{} pieces {:?}", out.order.len(), out.stats);
         check(&out);
         out
@@ -269,22 +290,41 @@ mod tests {
     fn solid_box() {
         let out = run(&grid((8, 6, 4), &[bx(0, 0, 0, 8, 6, 4)]));
         assert!(out.repairs.is_empty());
-        assert!(out.order.len() < 8 * 6 * 4 / 3, "{} pieces", out.order.len());
+        assert!(
+            out.order.len() < 8 * 6 * 4 / 3,
+            "{} pieces",
+            out.order.len()
+        );
     }
 
     #[test]
     fn arch_needs_pieces_added_from_below() {
         // The span is two layers thick, so staggered bricks can cross the gap.
-        let g = grid((10, 2, 6), &[bx(0, 0, 0, 2, 2, 4), bx(8, 0, 0, 2, 2, 4), bx(0, 0, 4, 10, 2, 2)]);
+        let g = grid(
+            (10, 2, 6),
+            &[
+                bx(0, 0, 0, 2, 2, 4),
+                bx(8, 0, 0, 2, 2, 4),
+                bx(0, 0, 4, 10, 2, 2),
+            ],
+        );
         let out = run(&g);
-        assert!(out.order.iter().any(|r| matches!(r.anchor, Anchor::Piece(a) if a.origin.z > r.piece.origin.z)));
+        assert!(out
+            .order
+            .iter()
+            .any(|r| matches!(r.anchor, Anchor::Piece(a) if a.origin.z > r.piece.origin.z)));
     }
 
     #[test]
     fn towers_on_a_base_and_an_island() {
         let g = grid(
             (12, 12, 12),
-            &[bx(0, 0, 0, 12, 12, 2), bx(1, 1, 2, 3, 3, 6), bx(7, 6, 2, 4, 5, 4), bx(6, 0, 9, 3, 3, 2)],
+            &[
+                bx(0, 0, 0, 12, 12, 2),
+                bx(1, 1, 2, 3, 3, 6),
+                bx(7, 6, 2, 4, 5, 4),
+                bx(6, 0, 9, 3, 3, 2),
+            ],
         );
         let out = run(&g);
         assert_eq!(out.repairs.supported_islands, 1);
@@ -310,32 +350,83 @@ mod debug_tests {
         let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
         for (sx, sy, sz) in [(8, 6, 4), (12, 10, 6), (20, 16, 6), (30, 24, 6)] {
             let mut g = VoxelGrid::new(sx, sy, sz + 2);
-            g.set_box(&CellBox { min: Cell::new(0, 0, 2), sx, sy, sz }, true);
+            g.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 2),
+                    sx,
+                    sy,
+                    sz,
+                },
+                true,
+            );
             let mut built = VoxelGrid::new(sx, sy, sz + 2);
-            built.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            built.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 0),
+                    sx,
+                    sy,
+                    sz: 2,
+                },
+                true,
+            );
             let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(5));
-            o.restarts = 0;
             let search = PartSearch::new(&rules, &o, Instant::now() + o.time_budget);
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let t = Instant::now();
-            let r = search.run(g, &built, &mut rng, &mut stats);
-            let what = match r { PartResult::Built(t) => format!("built {}", t.len()), PartResult::Unbuildable => "unbuildable".into(), PartResult::OutOfBudget => "budget".into() };
-            eprintln!("grounded {sx}x{sy}x{sz}: {what} in {:?} {stats:?}", t.elapsed());
+            let r = search.run(g, &built, 100_000, &mut rng, &mut stats);
+            let what = match r {
+                PartResult::Built(t) => format!("built {}", t.len()),
+                PartResult::Unbuildable => "unbuildable".into(),
+                PartResult::OutOfBudget => "budget".into(),
+            };
+            eprintln!(
+                "grounded {sx}x{sy}x{sz}: {what} in {:?} {stats:?}",
+                t.elapsed()
+            );
         }
     }
     #[test]
     fn tiny_debug() {
         let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
-        for (sx, sy, sz) in [(2, 2, 2), (4, 2, 2), (4, 4, 2), (6, 4, 2), (8, 6, 2), (12, 10, 2), (20, 16, 2), (6, 4, 3), (30, 24, 2), (48, 40, 2)] {
+        for (sx, sy, sz) in [
+            (2, 2, 2),
+            (4, 2, 2),
+            (4, 4, 2),
+            (6, 4, 2),
+            (8, 6, 2),
+            (12, 10, 2),
+            (20, 16, 2),
+            (6, 4, 3),
+            (30, 24, 2),
+            (48, 40, 2),
+        ] {
             let mut g = VoxelGrid::new(sx, sy, sz);
-            g.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz }, true);
+            g.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 0),
+                    sx,
+                    sy,
+                    sz,
+                },
+                true,
+            );
             let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(3));
-            o.restarts = 0;
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let r = grow::grow(&g, &rules, &o, Instant::now() + o.time_budget, &mut rng, &mut stats);
-            let what = match r { PartResult::Built(t) => format!("built {}", t.len()), PartResult::Unbuildable => "unbuildable".into(), PartResult::OutOfBudget => "budget".into() };
+            let r = grow::grow(
+                &g,
+                &rules,
+                &o,
+                Instant::now() + o.time_budget,
+                &mut rng,
+                &mut stats,
+            );
+            let what = match r {
+                PartResult::Built(t) => format!("built {}", t.len()),
+                PartResult::Unbuildable => "unbuildable".into(),
+                PartResult::OutOfBudget => "budget".into(),
+            };
             eprintln!("{sx}x{sy}x{sz}: {what} {stats:?}");
         }
     }

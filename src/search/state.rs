@@ -44,7 +44,14 @@ pub struct Removal {
 impl Removal {
     /// A piece placed by forward generation, as its backward removal.
     pub(crate) fn forward(piece: Placement, anchor: Anchor, rule: Option<RuleId>) -> Removal {
-        Removal { piece, anchor, rule, was_committed: None, new_anchor: None, marked: false }
+        Removal {
+            piece,
+            anchor,
+            rule,
+            was_committed: None,
+            new_anchor: None,
+            marked: false,
+        }
     }
 
     /// The starting rule `ε -> p`, reversed.
@@ -124,8 +131,16 @@ impl<'g> State<'g> {
 
     /// Whether `b`'s footprint touches cells of `g` directly above or below.
     fn touches(g: &VoxelGrid, b: &CellBox) -> bool {
-        let below = CellBox { min: b.min.offset(0, 0, -1), sz: 1, ..*b };
-        let above = CellBox { min: b.min.offset(0, 0, b.sz), sz: 1, ..*b };
+        let below = CellBox {
+            min: b.min.offset(0, 0, -1),
+            sz: 1,
+            ..*b
+        };
+        let above = CellBox {
+            min: b.min.offset(0, 0, b.sz),
+            sz: 1,
+            ..*b
+        };
         g.any_set(&below) || g.any_set(&above)
     }
 
@@ -137,9 +152,15 @@ impl<'g> State<'g> {
     /// Whether `b` has a free cell beside it in its own layers: the piece is
     /// on the outside of what is left, seen from above.
     pub fn on_side_boundary(&self, b: &CellBox) -> bool {
-        let ring = CellBox { min: b.min.offset(-1, -1, 0), sx: b.sx + 2, sy: b.sy + 2, ..*b };
+        let ring = CellBox {
+            min: b.min.offset(-1, -1, 0),
+            sx: b.sx + 2,
+            sy: b.sy + 2,
+            ..*b
+        };
         let found = ring.cells().any(|c| {
-            let side = (c.x < b.min.x || c.x >= b.min.x + b.sx) != (c.y < b.min.y || c.y >= b.min.y + b.sy);
+            let side = (c.x < b.min.x || c.x >= b.min.x + b.sx)
+                != (c.y < b.min.y || c.y >= b.min.y + b.sy);
             side && !self.v.get(c)
         });
         found
@@ -157,8 +178,16 @@ impl<'g> State<'g> {
         if Self::touches(&self.peeled, b) || self.touches_built(b) {
             return true;
         }
-        let below = CellBox { min: b.min.offset(0, 0, -1), sz: 1, ..*b };
-        let above = CellBox { min: b.min.offset(0, 0, b.sz), sz: 1, ..*b };
+        let below = CellBox {
+            min: b.min.offset(0, 0, -1),
+            sz: 1,
+            ..*b
+        };
+        let above = CellBox {
+            min: b.min.offset(0, 0, b.sz),
+            sz: 1,
+            ..*b
+        };
         [below, above].iter().any(|n| {
             n.cells()
                 .any(|c| self.v.in_bounds(c) && self.owner[self.v.index(c)] != NONE)
@@ -196,7 +225,14 @@ impl<'g> State<'g> {
         }
         let prev = self.any_matched;
         self.any_matched = true;
-        Removal { piece, anchor, rule, was_committed, new_anchor, marked: !prev }
+        Removal {
+            piece,
+            anchor,
+            rule,
+            was_committed,
+            new_anchor,
+            marked: !prev,
+        }
     }
 
     /// Undoes `r`, which must be the last applied removal.
@@ -234,11 +270,34 @@ impl<'g> State<'g> {
     pub fn placeable(&self, b: &CellBox) -> bool {
         let (_, _, nz) = self.v.dims();
         let top = b.min.z + b.sz;
-        let above = CellBox { min: b.min.offset(0, 0, b.sz), sz: (nz - top).max(1), ..*b };
-        let below = CellBox { min: Cell::new(b.min.x, b.min.y, 0), sz: b.min.z.max(1), ..*b };
+        let above = CellBox {
+            min: b.min.offset(0, 0, b.sz),
+            sz: (nz - top).max(1),
+            ..*b
+        };
+        let below = CellBox {
+            min: Cell::new(b.min.x, b.min.y, 0),
+            sz: b.min.z.max(1),
+            ..*b
+        };
         let blocked = |bx: &CellBox| self.v.any_set(bx) || self.built.any_set(bx);
         if (top >= nz || !blocked(&above)) || (b.min.z == 0 || !blocked(&below)) {
             return true;
+        }
+        // Held between something right above and something right below: no
+        // move at all is possible.
+        let just_above = CellBox {
+            min: b.min.offset(0, 0, b.sz),
+            sz: 1,
+            ..*b
+        };
+        let just_below = CellBox {
+            min: b.min.offset(0, 0, -1),
+            sz: 1,
+            ..*b
+        };
+        if blocked(&just_above) && blocked(&just_below) {
+            return false;
         }
         self.flood(b)
     }
@@ -247,21 +306,33 @@ impl<'g> State<'g> {
         let (nx, ny, nz) = self.v.dims();
         let (mx, my) = (b.sx + 1, b.sy + 1);
         let (w, d, h) = (nx + 2 * mx, ny + 2 * my, nz + 2 * b.sz + 2);
-        let idx = |p: Cell| {
-            (((p.z + b.sz + 1) * d + (p.y + my)) * w + (p.x + mx)) as usize
-        };
+        let idx = |p: Cell| (((p.z + b.sz + 1) * d + (p.y + my)) * w + (p.x + mx)) as usize;
         let inside = |p: Cell| {
-            p.x >= -mx && p.y >= -my && p.z >= -b.sz - 1 && p.x < nx + mx - 0 && p.y < ny + my && p.z < nz + b.sz + 1
+            p.x >= -mx
+                && p.y >= -my
+                && p.z >= -b.sz - 1
+                && p.x < nx + mx - 0
+                && p.y < ny + my
+                && p.z < nz + b.sz + 1
         };
         let at = |p: Cell| CellBox { min: p, ..*b };
         let blocked = |bx: &CellBox| self.v.any_set(bx) || self.built.any_set(bx);
         let clear = |p: Cell| {
             let bx = at(p);
-            let pad = CellBox { min: p.offset(0, 0, -1), sz: b.sz + 2, ..*b };
+            let pad = CellBox {
+                min: p.offset(0, 0, -1),
+                sz: b.sz + 2,
+                ..*b
+            };
             !blocked(&bx) && !blocked(&pad)
         };
         let outside = |p: Cell| {
-            p.x + b.sx <= 0 || p.y + b.sy <= 0 || p.z + b.sz <= 0 || p.x >= nx || p.y >= ny || p.z >= nz
+            p.x + b.sx <= 0
+                || p.y + b.sy <= 0
+                || p.z + b.sz <= 0
+                || p.x >= nx
+                || p.y >= ny
+                || p.z >= nz
         };
         let mut seen = vec![false; (w * d * h) as usize];
         let mut queue = std::collections::VecDeque::new();
@@ -276,7 +347,14 @@ impl<'g> State<'g> {
                 continue;
             }
             let clear_here = clear(p);
-            for (dx, dy, dz) in [(0, 0, 1), (0, 0, -1), (1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)] {
+            for (dx, dy, dz) in [
+                (0, 0, 1),
+                (0, 0, -1),
+                (1, 0, 0),
+                (-1, 0, 0),
+                (0, 1, 0),
+                (0, -1, 0),
+            ] {
                 let q = p.offset(dx, dy, dz);
                 if !inside(q) || seen[idx(q)] {
                     continue;
@@ -406,7 +484,7 @@ impl<'g> State<'g> {
             sy: bx.sy + 2 * r,
             sz: bx.sz + 2 * dz,
         };
-        let mut regions = vec![grow(b, 3, 1)];
+        let mut regions = vec![grow(b, 1, 1)];
         if let Some(a) = anchor {
             regions.push(grow(a, 1, 0));
         }
@@ -427,15 +505,26 @@ impl<'g> State<'g> {
         for &(sx, sy) in &self.footprints {
             for oy in 0..sy {
                 for ox in 0..sx {
-                    let bx = CellBox { min: u.offset(-ox, -oy, 0), sx, sy, sz: 1 };
+                    let bx = CellBox {
+                        min: u.offset(-ox, -oy, 0),
+                        sx,
+                        sy,
+                        sz: 1,
+                    };
                     if !self.v.all_set(&bx) {
                         continue;
                     }
                     if bx.cells().any(|c| self.owner[self.v.index(c)] != NONE) {
                         continue;
                     }
-                    let below = CellBox { min: bx.min.offset(0, 0, -1), ..bx };
-                    let above = CellBox { min: bx.min.offset(0, 0, 1), ..bx };
+                    let below = CellBox {
+                        min: bx.min.offset(0, 0, -1),
+                        ..bx
+                    };
+                    let above = CellBox {
+                        min: bx.min.offset(0, 0, 1),
+                        ..bx
+                    };
                     if self.v.any_set(&below)
                         || self.v.any_set(&above)
                         || self.built.any_set(&below)
