@@ -164,8 +164,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
         let rep = &r.repairs;
         if !rep.is_empty() {
             println!(
-                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels left out that no rule could join",
-                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.dropped_unbuildable
+                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make the base two layers thick, {} voxels left out that no rule could join",
+                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.base_voxels, rep.dropped_unbuildable
             );
         }
         let s = &r.seconds;
@@ -220,7 +220,17 @@ fn main() -> ExitCode {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // One line: the error, then any cause its message does not
+            // already say.
+            let mut line = e.to_string();
+            for cause in e.chain().skip(1) {
+                let c = cause.to_string();
+                if !line.contains(&c) {
+                    line.push_str(": ");
+                    line.push_str(&c);
+                }
+            }
+            eprintln!("error: {line}");
             ExitCode::from(2)
         }
     }

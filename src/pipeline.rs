@@ -65,23 +65,23 @@ pub enum BuildError {
     #[error(transparent)]
     Mesh(#[from] MeshError),
     /// The mesh cannot be voxelized at this size.
-    #[error("{file}: {source}")]
+    #[error("{file}: {reason}")]
     Voxelize {
         /// The input file.
         file: String,
         /// Why.
-        source: VoxelizeError,
+        reason: VoxelizeError,
     },
     /// The rule file is bad.
     #[error(transparent)]
     Rules(#[from] RuleError),
     /// The search found no build.
-    #[error("{file}: {source}")]
+    #[error("{file}: {reason}")]
     Search {
         /// The input file.
         file: String,
         /// Why.
-        source: SearchError,
+        reason: SearchError,
     },
     /// The verifier refused the search's build: a bug, never bad input.
     #[error("internal error: the build of {file} failed verification ({report}); please report this with the input and options")]
@@ -92,12 +92,12 @@ pub enum BuildError {
         report: String,
     },
     /// An output could not be written.
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write: {reason}")]
     Write {
         /// The output file.
         path: String,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
@@ -247,9 +247,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let vopts = VoxelizeOptions::default()
         .with_sizing(opts.sizing)
         .with_up(opts.up);
-    let model = voxelize(&mesh, &vopts).map_err(|source| BuildError::Voxelize {
+    let model = voxelize(&mesh, &vopts).map_err(|reason| BuildError::Voxelize {
         file: file.clone(),
-        source,
+        reason,
     })?;
     times.voxelize = secs(t);
     progress.done();
@@ -257,9 +257,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     progress.stage("searching");
     let t = Instant::now();
     let outcome =
-        search::build(&model.grid, &rules, &opts.search).map_err(|source| BuildError::Search {
+        search::build(&model.grid, &rules, &opts.search).map_err(|reason| BuildError::Search {
             file: file.clone(),
-            source,
+            reason,
         })?;
     times.search = secs(t);
     progress.done();
@@ -285,9 +285,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     progress.stage("writing");
     let t = Instant::now();
-    std::fs::create_dir_all(&opts.out_dir).map_err(|source| BuildError::Write {
+    std::fs::create_dir_all(&opts.out_dir).map_err(|reason| BuildError::Write {
         path: opts.out_dir.display().to_string(),
-        source,
+        reason,
     })?;
     let stem = opts
         .input
@@ -370,10 +370,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             report_path.display().to_string(),
         ],
     };
-    write_atomic(&ldr_path, |w| write_ldr(w, &assembly, &meta)).map_err(|source| {
+    write_atomic(&ldr_path, |w| write_ldr(w, &assembly, &meta)).map_err(|reason| {
         BuildError::Write {
             path: ldr_path.display().to_string(),
-            source,
+            reason,
         }
     })?;
     report.seconds.write = secs(t);
@@ -381,9 +381,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         serde_json::to_writer_pretty(&mut *w, &report).map_err(std::io::Error::other)?;
         w.write_all(b"\n")
     })
-    .map_err(|source| BuildError::Write {
+    .map_err(|reason| BuildError::Write {
         path: report_path.display().to_string(),
-        source,
+        reason,
     })?;
     progress.done();
     Ok(BuildOutput { assembly, report })

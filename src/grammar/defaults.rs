@@ -7,7 +7,7 @@
 //! more studs. A rule `A -> A + B` weighs
 //!
 //! ```text
-//! weight = studs(B) x joint(A, B) x side
+//! weight = studs(B)² x joint(A, B) x side
 //! joint  = 1  B sits exactly on A's footprint (seam on seam)
 //!          2  B lies inside A's footprint
 //!          3  B covers A's footprint and more (bridges A's seams)
@@ -115,9 +115,9 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
                             }
                             seen.extend(keys);
                             let side = if dir == Dir::Up { 1.0 } else { 0.5 };
-                            let weight = b.spec().studs() as f64
-                                * joint_factor((ax, ay), (dx, dy), (bx, by))
-                                * side;
+                            let studs = b.spec().studs() as f64;
+                            let weight =
+                                studs * studs * joint_factor((ax, ay), (dx, dy), (bx, by)) * side;
                             rules.push(Rule { weight, ..rule });
                         }
                     }
@@ -143,7 +143,7 @@ Statements (one a line, `#` starts a comment):
 
 Where the weights come from: no learned data yet, so they encode building
 practice (Bedford, The Unofficial LEGO Builder's Guide, ch. 2):
-  weight = studs(B) x joint x side
+  weight = studs(B)^2 x joint x side   (bigger bricks: fewer, stronger joints)
   joint  = 1 seam on seam, 2 inside A, 3 covers A, 4 staggered,
            6 staggered with B half on A (running bond)
   side   = 1 up, 0.5 down";

@@ -23,12 +23,12 @@ use crate::geom::Rot;
 #[derive(Debug, Error)]
 pub enum RuleError {
     /// The file could not be read.
-    #[error("{file}: cannot read the rule file: {source}")]
+    #[error("{file}: cannot read the rule file: {reason}")]
     Io {
         /// The file.
         file: String,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// A line is malformed or inconsistent.
     #[error("{file}:{line}: {message}")]
@@ -63,9 +63,9 @@ impl RuleError {
 impl RuleSet {
     /// Reads a rule file.
     pub fn load(path: &Path) -> Result<RuleSet, RuleError> {
-        let bytes = std::fs::read(path).map_err(|source| RuleError::Io {
+        let bytes = std::fs::read(path).map_err(|reason| RuleError::Io {
             file: path.display().to_string(),
-            source,
+            reason,
         })?;
         let text = String::from_utf8(bytes).map_err(|e| RuleError::File {
             file: path.display().to_string(),

@@ -28,6 +28,9 @@ use crate::voxel::VoxelGrid;
 
 const NONE: u32 = u32::MAX;
 
+/// Seeds tried for the first piece before voxels are left out.
+const MAX_SEEDS: usize = 16;
+
 struct Frame {
     target: Cell,
     slots: Vec<u32>,
@@ -66,18 +69,19 @@ pub(crate) fn grow(
         2 * bounds.min.y + bounds.sy - 1,
     );
     let seeds: Vec<Cell> = if built.is_empty() {
-        let seed = v
-            .layer_cells(bounds.min.z)
-            .min_by_key(|c| {
-                let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
-                (dx * dx + dy * dy, c.y, c.x)
-            })
-            .expect("non-empty bottom layer");
-        vec![seed]
+        // Prefer a cell with a voxel above it, so the next piece can connect.
+        let mut order: Vec<Cell> = v.layer_cells(bounds.min.z).collect();
+        order.sort_by_key(|c| {
+            let (dx, dy) = (2 * c.x - cx, 2 * c.y - cy);
+            (!v.get(c.offset(0, 0, 1)), dx * dx + dy * dy, c.y, c.x)
+        });
+        order.truncate(MAX_SEEDS);
+        order
     } else {
         v.cells().filter(|&c| on_built(c)).collect()
     };
     let dist = distances(v, &seeds);
+    let by_layer = !built.is_empty() || bounds.sz > 2;
     let mut cover = VoxelGrid::new(nx, ny, nz);
     let mut owner = vec![NONE; v.len()];
     let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
@@ -100,23 +104,12 @@ pub(crate) fn grow(
             owner[i] = id;
         }
     };
+    // With nothing built, the starting rule puts the biggest starting piece
+    // over the seed; if the growth from there is stuck before it ever leaves
+    // the first piece, the next seed is tried.
+    let mut seed_k = 0usize;
     if built.is_empty() {
-        // The starting rule: the biggest starting piece over the seed.
-        let seed = seeds[0];
-        let mut first = None;
-        'outer: for &(part, rot) in &starts {
-            let (sx, sy) = part.spec().footprint(rot);
-            for oy in 0..sy {
-                for ox in 0..sx {
-                    let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
-                    if v.all_set(&boxed(&p)) {
-                        first = Some(p);
-                        break 'outer;
-                    }
-                }
-            }
-        }
-        let Some(first) = first else {
+        let Some(first) = start_at(v, &starts, seeds[0]) else {
             return PartResult::Unbuildable;
         };
         place(&first, &mut cover, &mut owner, 0);
@@ -165,7 +158,7 @@ pub(crate) fn grow(
             return PartResult::OutOfBudget;
         }
         if stack.last().is_none_or(|f| f.placed) {
-            let target = nearest_uncovered(v, &cover, built, &dist);
+            let target = nearest_uncovered(v, &cover, built, by_layer, &dist);
             let done = 1.0 - left as f64 / total as f64;
             let b = (opts.b_min as f64 + (opts.b_max - opts.b_min) as f64 * done * done) as usize;
             let mut slots = sample(&weights, b, rng);
@@ -182,6 +175,7 @@ pub(crate) fn grow(
                 placed: false,
             });
         }
+        let at_root = stack.len() == 1;
         let f = stack.last_mut().expect("frame");
         let mut found: Option<(Placement, Anchor, Option<u32>)> = None;
         'scan: loop {
@@ -243,7 +237,8 @@ pub(crate) fn grow(
                 f.slot += 1;
                 f.corner = 0;
             }
-            if f.widened && (f.relaxed || backtracks_here < opts.max_backtracks_per_part) {
+            let may_backtrack = backtracks_here < opts.max_backtracks_per_part && !at_root;
+            if f.widened && (f.relaxed || may_backtrack) {
                 break;
             }
             if f.widened {
@@ -280,7 +275,20 @@ pub(crate) fn grow(
                 // The child frame is made on the next turn.
             }
             None => {
-                if backtracks_here >= opts.max_backtracks_per_part || placed.is_empty() {
+                if built.is_empty() && at_root && placed.len() == 1 && seed_k + 1 < seeds.len() {
+                    // Stuck right at the start: start elsewhere.
+                    seed_k += 1;
+                    let (p, _, _) = placed.pop().expect("the first piece");
+                    cover.set_box(&boxed(&p), false);
+                    owner.iter_mut().for_each(|o| *o = NONE);
+                    stack.clear();
+                    if let Some(first) = start_at(v, &starts, seeds[seed_k]) {
+                        place(&first, &mut cover, &mut owner, 0);
+                        placed.push((first, Anchor::Start, None));
+                    }
+                    continue;
+                }
+                if backtracks_here >= opts.max_backtracks_per_part || at_root {
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
                     let t = f.target;
@@ -327,6 +335,26 @@ pub(crate) fn grow(
     }
 }
 
+/// The biggest starting piece that covers `seed` and fits the voxels.
+fn start_at(
+    v: &VoxelGrid,
+    starts: &[(crate::catalog::PartKind, Rot)],
+    seed: Cell,
+) -> Option<Placement> {
+    for &(part, rot) in starts {
+        let (sx, sy) = part.spec().footprint(rot);
+        for oy in 0..sy {
+            for ox in 0..sx {
+                let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
+                if v.all_set(&boxed(&p)) {
+                    return Some(p);
+                }
+            }
+        }
+    }
+    None
+}
+
 /// Breadth-first distances from `seed` through face-adjacent voxels.
 fn distances(v: &VoxelGrid, seeds: &[Cell]) -> Vec<u32> {
     let mut d = vec![u32::MAX; v.len()];
@@ -357,15 +385,21 @@ fn distances(v: &VoxelGrid, seeds: &[Cell]) -> Vec<u32> {
 /// The next voxel to cover: among those with a placed piece directly above
 /// or below (so some piece over it connects), the lowest, then the nearest to
 /// the start; else the nearest of all.
-fn nearest_uncovered(v: &VoxelGrid, cover: &VoxelGrid, built: &VoxelGrid, dist: &[u32]) -> Cell {
+fn nearest_uncovered(
+    v: &VoxelGrid,
+    cover: &VoxelGrid,
+    built: &VoxelGrid,
+    by_layer: bool,
+    dist: &[u32],
+) -> Cell {
     v.cells()
         .filter(|&c| !cover.get(c))
         .min_by_key(|&c| {
             let (up, down) = (c.offset(0, 0, 1), c.offset(0, 0, -1));
             let supported = cover.get(up) || cover.get(down) || built.get(up) || built.get(down);
-            // Resting on a built part, the build goes up layer by layer, so
-            // no voxel is shut in between pieces above and below it.
-            let layer = if built.is_empty() { 0 } else { c.z };
+            // Past two layers the build goes up layer by layer, so no voxel
+            // is shut in between pieces above and below it.
+            let layer = if by_layer { c.z } else { 0 };
             (
                 !supported,
                 layer,

@@ -24,6 +24,10 @@ pub struct Repairs {
     pub supported_islands: usize,
     /// Voxels added as supports.
     pub support_voxels: usize,
+    /// Voxels added over the bottom layer where it had nothing above: a
+    /// single layer of bricks cannot hold together, so the base is made two
+    /// layers thick.
+    pub base_voxels: usize,
     /// Voxels left out because no rule could join them to the build.
     pub dropped_unbuildable: usize,
 }
@@ -136,6 +140,25 @@ pub fn repair_islands(v: &VoxelGrid) -> (VoxelGrid, Repairs) {
         }
     }
     (out, rep)
+}
+
+/// Makes the bottom layer two layers thick where it has nothing above:
+/// bricks side by side in one layer can only be joined by bricks above.
+pub fn thicken_base(v: &mut VoxelGrid, rep: &mut Repairs) {
+    let Some(b) = v.bounds() else { return };
+    let (_, _, nz) = v.dims();
+    if nz < 2 || b.sz < 2 {
+        return;
+    }
+    let z = b.min.z;
+    let bare: Vec<Cell> = v
+        .layer_cells(z)
+        .filter(|c| !v.get(c.offset(0, 0, 1)))
+        .collect();
+    for c in bare {
+        v.set(c.offset(0, 0, 1), true);
+        rep.base_voxels += 1;
+    }
 }
 
 /// The shortest vertical run of empty cells linking `island` to `joined`,

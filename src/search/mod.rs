@@ -152,7 +152,8 @@ pub fn build(
     }
     let started = Instant::now();
     let deadline = started + opts.time_budget;
-    let (fixed, repairs) = hierarchy::repair_islands(voxels);
+    let (mut fixed, mut repairs) = hierarchy::repair_islands(voxels);
+    hierarchy::thicken_base(&mut fixed, &mut repairs);
     let mut parts = split_parts(&fixed, opts.max_part_layers);
     let mut stats = SearchStats::default();
     let (nx, ny, nz) = fixed.dims();
@@ -205,7 +206,6 @@ pub fn build(
         }
     }
     stats.parts = parts.len() as u64;
-    let mut repairs = repairs;
     repairs.dropped_unbuildable = fixed.count() - built.count();
     Ok(SearchOutcome {
         order,
