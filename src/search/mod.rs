@@ -341,93 +341,59 @@ mod tests {
     }
 }
 #[cfg(test)]
-mod debug_tests {
+mod part_tests {
     use super::*;
     use crate::geom::{Cell, CellBox};
     use crate::grammar::default_rules_text;
+
+    fn rules() -> RuleSet {
+        RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap()
+    }
+
+    /// Backward tracing alone builds boxes resting on a built base: every
+    /// piece peeled, no node wasted.
     #[test]
-    fn grounded_debug() {
-        let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
-        for (sx, sy, sz) in [(8, 6, 4), (12, 10, 6), (20, 16, 6), (30, 24, 6)] {
+    fn backward_tracing_builds_parts_on_a_base() {
+        let rules = rules();
+        for (sx, sy, sz) in [(8, 6, 4), (12, 10, 6)] {
             let mut g = VoxelGrid::new(sx, sy, sz + 2);
-            g.set_box(
-                &CellBox {
-                    min: Cell::new(0, 0, 2),
-                    sx,
-                    sy,
-                    sz,
-                },
-                true,
-            );
+            g.set_box(&CellBox { min: Cell::new(0, 0, 2), sx, sy, sz }, true);
             let mut built = VoxelGrid::new(sx, sy, sz + 2);
-            built.set_box(
-                &CellBox {
-                    min: Cell::new(0, 0, 0),
-                    sx,
-                    sy,
-                    sz: 2,
-                },
-                true,
-            );
-            let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(5));
-            let search = PartSearch::new(&rules, &o, Instant::now() + o.time_budget);
+            built.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            let o = SearchOptions::default();
+            let search = PartSearch::new(&rules, &o, Instant::now() + Duration::from_secs(60));
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let t = Instant::now();
-            let r = search.run(g, &built, 100_000, &mut rng, &mut stats);
-            let what = match r {
-                PartResult::Built(t) => format!("built {}", t.len()),
-                PartResult::Unbuildable => "unbuildable".into(),
-                PartResult::OutOfBudget => "budget".into(),
+            let voxels = g.count();
+            let PartResult::Built(trace) = search.run(g, &built, 100_000, &mut rng, &mut stats) else {
+                panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
-            eprintln!(
-                "grounded {sx}x{sy}x{sz}: {what} in {:?} {stats:?}",
-                t.elapsed()
-            );
+            let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
+            assert_eq!(covered as usize, voxels);
+            assert!(trace.iter().any(|r| r.rule.is_some()), "rules applied in reverse");
+            assert!(trace.iter().any(|r| r.anchor == Anchor::Built), "pieces rest on the base");
         }
     }
+
+    /// The bottom part, grown forward from a starting piece, covers solid
+    /// two-layer slabs without leaving voxels out.
     #[test]
-    fn tiny_debug() {
-        let rules = RuleSet::parse(&default_rules_text(), "d".as_ref()).unwrap();
-        for (sx, sy, sz) in [
-            (2, 2, 2),
-            (4, 2, 2),
-            (4, 4, 2),
-            (6, 4, 2),
-            (8, 6, 2),
-            (12, 10, 2),
-            (20, 16, 2),
-            (6, 4, 3),
-            (30, 24, 2),
-            (48, 40, 2),
-        ] {
-            let mut g = VoxelGrid::new(sx, sy, sz);
-            g.set_box(
-                &CellBox {
-                    min: Cell::new(0, 0, 0),
-                    sx,
-                    sy,
-                    sz,
-                },
-                true,
-            );
-            let mut o = SearchOptions::default().with_time_budget(Duration::from_secs(3));
+    fn forward_growth_builds_two_layer_slabs() {
+        let rules = rules();
+        for (sx, sy) in [(2, 2), (6, 4), (12, 10), (30, 24)] {
+            let mut g = VoxelGrid::new(sx, sy, 2);
+            g.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            let o = SearchOptions::default();
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let r = grow::grow(
-                &g,
-                &rules,
-                &o,
-                Instant::now() + o.time_budget,
-                &mut rng,
-                &mut stats,
-            );
-            let what = match r {
-                PartResult::Built(t) => format!("built {}", t.len()),
-                PartResult::Unbuildable => "unbuildable".into(),
-                PartResult::OutOfBudget => "budget".into(),
-            };
-            eprintln!("{sx}x{sy}x{sz}: {what} {stats:?}");
+            let built = VoxelGrid::new(sx, sy, 2);
+            let before = g.count();
+            let r = grow::grow(&mut g, &built, &rules, &o, Instant::now() + Duration::from_secs(60), &mut rng, &mut stats);
+            let PartResult::Built(trace) = r else { panic!("{sx}x{sy} not built") };
+            assert_eq!(g.count(), before, "{sx}x{sy}: voxels left out: {stats:?}");
+            let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
+            assert_eq!(covered as usize, before);
+            assert_eq!(trace.iter().filter(|r| r.anchor == Anchor::Start).count(), 1);
         }
     }
 }
