@@ -86,7 +86,8 @@ struct BuildArgs {
     /// A rule file (see rules/default.rules); default: the built-in default rules.
     #[arg(long)]
     rules: Option<PathBuf>,
-    /// Put this many pieces in each step (default: one piece a step).
+    /// Put this many pieces in each step (default: one piece a step, or as few as keep a
+    /// big model within the 255 steps LeoCAD can show).
     #[arg(long, conflicts_with = "step_by", value_parser = clap::value_parser!(u32).range(1..))]
     step_size: Option<u32>,
     /// Group steps another way.
@@ -141,7 +142,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     opts.steps = match (a.step_size, a.step_by) {
         (Some(n), _) => StepGrouping::Size(n as usize),
         (None, Some(StepBy::Layer)) => StepGrouping::Layer,
-        (None, None) => StepGrouping::Each,
+        (None, None) => StepGrouping::Auto,
     };
     opts.search = opts
         .search

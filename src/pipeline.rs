@@ -37,7 +37,8 @@ pub struct BuildOptions {
     pub up: Up,
     /// A rule file; `None` for the built-in default rules.
     pub rules: Option<PathBuf>,
-    /// Step grouping in the outputs. Default one piece a step.
+    /// Step grouping in the outputs. Default one piece a step, grouped
+    /// further past 255 steps.
     pub steps: StepGrouping,
     /// Search tuning, including the seed.
     pub search: SearchOptions,
@@ -52,7 +53,7 @@ impl BuildOptions {
             sizing: Sizing::default(),
             up: Up::default(),
             rules: None,
-            steps: StepGrouping::Each,
+            steps: StepGrouping::Auto,
             search: SearchOptions::default(),
         }
     }
@@ -391,6 +392,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
 fn step_name(s: StepGrouping) -> String {
     match s {
+        StepGrouping::Auto => "one piece a step, at most 255 steps".into(),
         StepGrouping::Each => "one piece a step".into(),
         StepGrouping::Size(n) => format!("{n} pieces a step"),
         StepGrouping::Layer => "by layer".into(),
@@ -420,7 +422,8 @@ fn describe(opts: &BuildOptions) -> String {
         })
         .unwrap_or_default();
     let steps = match opts.steps {
-        StepGrouping::Each => String::new(),
+        StepGrouping::Auto => String::new(),
+        StepGrouping::Each => " --step-size 1".into(),
         StepGrouping::Size(n) => format!(" --step-size {n}"),
         StepGrouping::Layer => " --step-by layer".into(),
     };

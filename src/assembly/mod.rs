@@ -94,12 +94,17 @@ impl Assembly {
     /// Regroups the steps: `StepGrouping::Each` one piece a step,
     /// `Size(n)` n pieces a step, `Layer` one step per layer run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
+        let grouping = match grouping {
+            StepGrouping::Auto if self.pieces.len() <= MAX_STEPS => StepGrouping::Each,
+            StepGrouping::Auto => StepGrouping::Size(self.pieces.len().div_ceil(MAX_STEPS)),
+            g => g,
+        };
         let mut step = 0u32;
         let mut in_step = 0usize;
         let mut last_z = i32::MIN;
         for p in &mut self.pieces {
             let new_step = match grouping {
-                StepGrouping::Each => true,
+                StepGrouping::Each | StepGrouping::Auto => true,
                 StepGrouping::Size(n) => in_step >= n.max(1),
                 StepGrouping::Layer => p.placement.origin.z != last_z,
             };
@@ -123,9 +128,16 @@ impl Assembly {
     }
 }
 
+/// Steps LeoCAD shows at most (its step counter is one byte); a model with
+/// more steps loads, but its later steps are missing from the view.
+pub const MAX_STEPS: usize = 255;
+
 /// How pieces are grouped into steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum StepGrouping {
+    /// One piece a step, or as few pieces a step as keep the steps within
+    /// [`MAX_STEPS`] (the default).
+    Auto,
     /// One piece a step (the default).
     Each,
     /// At most this many pieces a step.

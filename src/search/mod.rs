@@ -357,21 +357,44 @@ mod part_tests {
         let rules = rules();
         for (sx, sy, sz) in [(8, 6, 4), (12, 10, 6)] {
             let mut g = VoxelGrid::new(sx, sy, sz + 2);
-            g.set_box(&CellBox { min: Cell::new(0, 0, 2), sx, sy, sz }, true);
+            g.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 2),
+                    sx,
+                    sy,
+                    sz,
+                },
+                true,
+            );
             let mut built = VoxelGrid::new(sx, sy, sz + 2);
-            built.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            built.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 0),
+                    sx,
+                    sy,
+                    sz: 2,
+                },
+                true,
+            );
             let o = SearchOptions::default();
             let search = PartSearch::new(&rules, &o, Instant::now() + Duration::from_secs(60));
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let voxels = g.count();
-            let PartResult::Built(trace) = search.run(g, &built, 100_000, &mut rng, &mut stats) else {
+            let PartResult::Built(trace) = search.run(g, &built, 100_000, &mut rng, &mut stats)
+            else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
             let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
             assert_eq!(covered as usize, voxels);
-            assert!(trace.iter().any(|r| r.rule.is_some()), "rules applied in reverse");
-            assert!(trace.iter().any(|r| r.anchor == Anchor::Built), "pieces rest on the base");
+            assert!(
+                trace.iter().any(|r| r.rule.is_some()),
+                "rules applied in reverse"
+            );
+            assert!(
+                trace.iter().any(|r| r.anchor == Anchor::Built),
+                "pieces rest on the base"
+            );
         }
     }
 
@@ -382,18 +405,39 @@ mod part_tests {
         let rules = rules();
         for (sx, sy) in [(2, 2), (6, 4), (12, 10), (30, 24)] {
             let mut g = VoxelGrid::new(sx, sy, 2);
-            g.set_box(&CellBox { min: Cell::new(0, 0, 0), sx, sy, sz: 2 }, true);
+            g.set_box(
+                &CellBox {
+                    min: Cell::new(0, 0, 0),
+                    sx,
+                    sy,
+                    sz: 2,
+                },
+                true,
+            );
             let o = SearchOptions::default();
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let built = VoxelGrid::new(sx, sy, 2);
             let before = g.count();
-            let r = grow::grow(&mut g, &built, &rules, &o, Instant::now() + Duration::from_secs(60), &mut rng, &mut stats);
-            let PartResult::Built(trace) = r else { panic!("{sx}x{sy} not built") };
+            let r = grow::grow(
+                &mut g,
+                &built,
+                &rules,
+                &o,
+                Instant::now() + Duration::from_secs(60),
+                &mut rng,
+                &mut stats,
+            );
+            let PartResult::Built(trace) = r else {
+                panic!("{sx}x{sy} not built")
+            };
             assert_eq!(g.count(), before, "{sx}x{sy}: voxels left out: {stats:?}");
             let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
             assert_eq!(covered as usize, before);
-            assert_eq!(trace.iter().filter(|r| r.anchor == Anchor::Start).count(), 1);
+            assert_eq!(
+                trace.iter().filter(|r| r.anchor == Anchor::Start).count(),
+                1
+            );
         }
     }
 }
