@@ -7,7 +7,7 @@
 //! more studs. A rule `A -> A + B` weighs
 //!
 //! ```text
-//! weight = studs(B)² x joint(A, B) x side
+//! weight = studs(A) x studs(B) x joint(A, B) x side
 //! joint  = 1  B sits exactly on A's footprint (seam on seam)
 //!          2  B lies inside A's footprint
 //!          3  B covers A's footprint and more (bridges A's seams)
@@ -143,7 +143,7 @@ Statements (one a line, `#` starts a comment):
 
 Where the weights come from: no learned data yet, so they encode building
 practice (Bedford, The Unofficial LEGO Builder's Guide, ch. 2):
-  weight = studs(B)^2 x joint x side   (bigger bricks: fewer, stronger joints)
+  weight = studs(A) x studs(B) x joint x side   (big bricks: fewer, stronger joints)
   joint  = 1 seam on seam, 2 inside A, 3 covers A, 4 staggered,
            6 staggered with B half on A (running bond)
   side   = 1 up, 0.5 down";

@@ -117,9 +117,11 @@ impl<'a> PartSearch<'a> {
         // Small footprints first: they fit most often.
         footprints.sort_by_key(|&(x, y)| (x * y, x, y));
         let mut by_shape: Vec<u32> = (0..rules.variants().len() as u32).collect();
+        // Big new pieces first, then big anchors: fewer, bigger bricks.
         by_shape.sort_by_key(|&i| {
             let v = &rules.variants()[i as usize];
-            (v.added, v.added_rot, i)
+            let studs = |p: PartKind| std::cmp::Reverse(p.spec().studs());
+            (studs(v.added), v.added, v.added_rot, studs(v.anchor), i)
         });
         PartSearch {
             rules,
@@ -494,7 +496,7 @@ impl<'a> PartSearch<'a> {
 
 /// The cell orders the scans follow. With a structure built below, up rules
 /// scan from the top layer down and down rules from the bottom up, each layer
-/// from the outside in. With nothing built (the bottom part), the scan goes
+/// in raster order. With nothing built (the bottom part), the scan goes
 /// from the outside in over all layers together, top first, so the pieces
 /// peeled last, the first ones built, sit in the middle.
 fn scan_orders(v: &VoxelGrid, built: bool) -> (Vec<Cell>, Vec<Cell>) {
@@ -511,8 +513,11 @@ fn scan_orders(v: &VoxelGrid, built: bool) -> (Vec<Cell>, Vec<Cell>) {
     let mut down = cells.clone();
     let mut up = cells;
     if built {
-        up.sort_by_key(|c| (std::cmp::Reverse(c.z), std::cmp::Reverse(dist(c)), c.y, c.x));
-        down.sort_by_key(|c| (c.z, std::cmp::Reverse(dist(c)), c.y, c.x));
+        // Raster order within a layer: the new piece's minimum corner sits
+        // on the scanned cell, so the first free cell in raster order leaves
+        // room for the biggest pieces.
+        up.sort_by_key(|c| (std::cmp::Reverse(c.z), c.y, c.x));
+        down.sort_by_key(|c| (c.z, c.y, c.x));
     } else {
         up.sort_by_key(|c| (std::cmp::Reverse(dist(c)), std::cmp::Reverse(c.z), c.y, c.x));
         down.clear();
