@@ -52,6 +52,9 @@ fn joint_factor(a: (i32, i32), b_at: (i32, i32), b: (i32, i32)) -> f64 {
     }
 }
 
+/// A rotated rule's geometry: anchor, its turn, new piece, its turn, offset, side.
+type VariantKey = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
+
 /// Generates the rule set for `alphabet`: every pair, every rotation of the
 /// new piece, every overlapping offset, up and down; one rule per class of
 /// rules that only differ by a turn of the whole.
@@ -65,7 +68,7 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
         .map(|&part| StartRule { part, line: 0 })
         .collect();
     let mut rules = Vec::new();
-    let mut seen: HashSet<(PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir)> = HashSet::new();
+    let mut seen: HashSet<VariantKey> = HashSet::new();
     for &a in &parts {
         for &b in &parts {
             let rots: &[Rot] = if b.spec().studs_x == b.spec().studs_y {

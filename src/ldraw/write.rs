@@ -49,7 +49,7 @@ pub fn write_ldr(w: &mut dyn Write, asm: &Assembly, meta: &LdrMeta) -> io::Resul
             }
         }
         writeln!(w, " {}.dat", p.part.spec().id)?;
-        let step_ends = asm.pieces.get(i + 1).map_or(true, |n| n.step != piece.step);
+        let step_ends = asm.pieces.get(i + 1).is_none_or(|n| n.step != piece.step);
         if step_ends {
             writeln!(w, "0 STEP")?;
         }

@@ -311,7 +311,7 @@ impl<'g> State<'g> {
             p.x >= -mx
                 && p.y >= -my
                 && p.z >= -b.sz - 1
-                && p.x < nx + mx - 0
+                && p.x < nx + mx
                 && p.y < ny + my
                 && p.z < nz + b.sz + 1
         };
@@ -431,10 +431,9 @@ impl<'g> State<'g> {
                 if corner_xy {
                     continue;
                 }
-                if (vertical_ring && in_footprint) || side_ring || bx.contains(c) {
-                    if self.v.get(c) {
-                        seeds.push(c);
-                    }
+                if ((vertical_ring && in_footprint) || side_ring || bx.contains(c)) && self.v.get(c)
+                {
+                    seeds.push(c);
                 }
             }
         };
