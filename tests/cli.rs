@@ -1,0 +1,507 @@
+//! End-to-end tests of the `brickwright` binary: every fixture builds and
+//! verifies, builds are deterministic, the `.ldr` header and steps match the
+//! report, and bad input fails with one clean line and no files left behind.
+//!
+//! Each test runs the built binary in its own temporary directory. Sizes are
+//! small (10 studs) so the whole file stays fast on two cores.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+use tempfile::TempDir;
+
+/// What a run of the binary left behind.
+struct Run {
+    code: Option<i32>,
+    stdout: String,
+    stderr: String,
+}
+
+impl Run {
+    /// A one-line summary for assertion messages.
+    fn describe(&self) -> String {
+        format!(
+            "exit {:?}\n--- stdout\n{}--- stderr\n{}",
+            self.code, self.stdout, self.stderr
+        )
+    }
+
+    fn assert_ok(&self) {
+        assert_eq!(self.code, Some(0), "expected success\n{}", self.describe());
+    }
+
+    /// Exit 2 with exactly one line on stderr, `error: ...`, no panic.
+    fn assert_clean_error(&self) {
+        assert_eq!(self.code, Some(2), "expected exit 2\n{}", self.describe());
+        assert!(
+            !self.stderr.contains("panicked"),
+            "panicked\n{}",
+            self.describe()
+        );
+        let lines: Vec<&str> = self.stderr.lines().collect();
+        assert_eq!(
+            lines.len(),
+            1,
+            "expected one line on stderr\n{}",
+            self.describe()
+        );
+        assert!(
+            lines[0].starts_with("error: "),
+            "stderr must start with `error: `\n{}",
+            self.describe()
+        );
+    }
+}
+
+/// Runs `brickwright ARGS` in `cwd`.
+fn run_in(cwd: &Path, args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_brickwright"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("cannot start the brickwright binary");
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name)
+}
+
+fn tempdir() -> TempDir {
+    tempfile::tempdir().expect("cannot make a temporary directory")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("test paths are UTF-8")
+}
+
+/// The options every small build uses.
+const SMALL: [&str; 5] = ["--studs", "10", "--time-budget", "60", "--quiet"];
+
+/// `brickwright build INPUT -o OUT SMALL EXTRA...`, run in `cwd`.
+fn build(cwd: &Path, input: &Path, out: &Path, extra: &[&str]) -> Run {
+    let mut args = vec!["build", s(input), "-o", s(out)];
+    args.extend_from_slice(&SMALL);
+    args.extend_from_slice(extra);
+    run_in(cwd, &args)
+}
+
+fn read_report(out: &Path) -> Value {
+    let path = out.join("report.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
+}
+
+fn report_u64(report: &Value, field: &str) -> u64 {
+    report[field]
+        .as_u64()
+        .unwrap_or_else(|| panic!("report.json: `{field}` is not a whole number: {report}"))
+}
+
+/// Every file (not directory) under `dir`, recursively, sorted.
+fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries {
+            let path = e.expect("readable directory entry").path();
+            if path.is_dir() {
+                todo.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+fn count_steps(ldr: &str) -> usize {
+    ldr.lines().filter(|l| l.trim() == "0 STEP").count()
+}
+
+/// Builds `name` small, checks the report, and verifies the `.ldr`.
+fn build_and_verify(name: &str) {
+    let tmp = tempdir();
+    let out = tmp.path().join("out");
+    let input = fixture(name);
+    let run = build(tmp.path(), &input, &out, &[]);
+    run.assert_ok();
+    assert_eq!(run.stdout, "", "--quiet must print nothing");
+    assert_eq!(run.stderr, "", "--quiet must print nothing");
+
+    let stem = Path::new(name).file_stem().unwrap().to_str().unwrap();
+    let ldr = out.join(format!("{stem}.ldr"));
+    assert!(ldr.is_file(), "{} was not written", ldr.display());
+    let mut expected = vec![ldr.clone(), out.join("report.json")];
+    expected.sort();
+    assert_eq!(
+        files_under(tmp.path()),
+        expected,
+        "exactly the .ldr and report.json, nothing else"
+    );
+
+    let report = read_report(&out);
+    assert_eq!(report_u64(&report, "components"), 1, "{report}");
+    let pieces = report_u64(&report, "pieces");
+    assert!(pieces > 0, "{report}");
+    let text = std::fs::read_to_string(&ldr).unwrap();
+    let lines = text.lines().filter(|l| l.starts_with("1 ")).count();
+    assert_eq!(lines as u64, pieces, "one type-1 line a piece");
+
+    let check = run_in(tmp.path(), &["verify", s(&ldr)]);
+    check.assert_ok();
+    assert!(check.stdout.contains("OK"), "{}", check.describe());
+}
+
+macro_rules! fixtures_build {
+    ($($test:ident: $file:literal,)*) => {
+        $(
+            #[test]
+            fn $test() {
+                build_and_verify($file);
+            }
+        )*
+
+        /// The good fixtures with a test above.
+        const GOOD_FIXTURES: &[&str] = &[$($file),*];
+    };
+}
+
+fixtures_build! {
+    builds_box: "box.obj",
+    builds_staircase: "staircase.obj",
+    builds_house: "house.obj",
+    builds_mug: "mug.obj",
+    builds_arch: "arch.obj",
+    builds_floating: "floating.obj",
+    builds_open_box: "open_box.obj",
+    builds_tower: "tower.glb",
+    builds_wedge: "wedge.stl",
+}
+
+#[test]
+fn every_fixture_has_a_build_test() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let path = e.unwrap().path();
+        let name = path.file_name().unwrap().to_str().unwrap();
+        if path.is_file() && name != "README.md" {
+            assert!(
+                GOOD_FIXTURES.contains(&name),
+                "fixtures/{name} has no build test in tests/cli.rs"
+            );
+        }
+    }
+}
+
+/// Copies what a build wrote out of `out`, so the next build can write the
+/// same paths (report.json records them).
+fn take(out: &Path, stem: &str) -> (Vec<u8>, Value) {
+    let ldr = std::fs::read(out.join(format!("{stem}.ldr"))).unwrap();
+    let mut report = read_report(out);
+    report
+        .as_object_mut()
+        .expect("report.json is an object")
+        .remove("seconds");
+    std::fs::remove_dir_all(out).unwrap();
+    (ldr, report)
+}
+
+#[test]
+fn same_input_and_seed_give_the_same_build() {
+    for (name, stem) in [("house.obj", "house"), ("mug.obj", "mug")] {
+        let tmp = tempdir();
+        let out = tmp.path().join("out");
+        let input = fixture(name);
+        let seed = ["--seed", "7"];
+        build(tmp.path(), &input, &out, &seed).assert_ok();
+        let (ldr1, report1) = take(&out, stem);
+        build(tmp.path(), &input, &out, &seed).assert_ok();
+        let (ldr2, report2) = take(&out, stem);
+        assert!(
+            ldr1 == ldr2,
+            "{name}: two builds with seed 7 wrote different .ldr files"
+        );
+        assert_eq!(report1, report2, "{name}: reports differ beyond `seconds`");
+
+        build(tmp.path(), &input, &out, &["--seed", "8"]).assert_ok();
+        let ldr = out.join(format!("{stem}.ldr"));
+        run_in(tmp.path(), &["verify", s(&ldr)]).assert_ok();
+        assert_eq!(read_report(&out)["options"]["seed"], 8);
+    }
+}
+
+#[test]
+fn ldr_header_and_steps_match_the_report() {
+    let tmp = tempdir();
+    let input = fixture("house.obj");
+
+    // Without --quiet: a summary on stdout.
+    let out = tmp.path().join("each");
+    let mut args = vec!["build", s(&input), "-o", s(&out)];
+    args.extend_from_slice(&["--studs", "10", "--seed", "3"]);
+    let run = run_in(tmp.path(), &args);
+    run.assert_ok();
+    assert!(run.stdout.contains("pieces"), "{}", run.describe());
+
+    let text = std::fs::read_to_string(out.join("house.ldr")).unwrap();
+    let header: Vec<&str> = text.lines().take_while(|l| l.starts_with("0 ")).collect();
+    assert!(
+        header.iter().any(|l| l.starts_with("0 Name: house.ldr")),
+        "no `0 Name:` line in {header:#?}"
+    );
+    assert!(
+        header.iter().any(|l| l.starts_with("0 Author: ")),
+        "no `0 Author:` line in {header:#?}"
+    );
+    let comments = header
+        .iter()
+        .filter(|l| l.starts_with("0 // "))
+        .copied()
+        .collect::<Vec<_>>()
+        .join("\n");
+    for want in [
+        concat!("brickwright ", env!("CARGO_PKG_VERSION")),
+        "house.obj",
+        "--studs 10",
+        "seed",
+        "3",
+    ] {
+        assert!(
+            comments.contains(want),
+            "header comments lack {want:?}:\n{comments}"
+        );
+    }
+    let report = read_report(&out);
+    let pieces = report_u64(&report, "pieces");
+    assert_eq!(count_steps(&text) as u64, report_u64(&report, "steps"));
+    assert_eq!(report_u64(&report, "steps"), pieces, "one piece a step");
+    assert!(
+        text.trim_end().ends_with("0 STEP"),
+        "the last step is closed"
+    );
+
+    let out = tmp.path().join("five");
+    build(
+        tmp.path(),
+        &input,
+        &out,
+        &["--seed", "3", "--step-size", "5"],
+    )
+    .assert_ok();
+    let text = std::fs::read_to_string(out.join("house.ldr")).unwrap();
+    let report = read_report(&out);
+    assert_eq!(
+        report_u64(&report, "pieces"),
+        pieces,
+        "same seed, same build"
+    );
+    assert_eq!(count_steps(&text) as u64, pieces.div_ceil(5));
+    assert_eq!(report_u64(&report, "steps"), pieces.div_ceil(5));
+
+    let out = tmp.path().join("layer");
+    build(
+        tmp.path(),
+        &input,
+        &out,
+        &["--seed", "3", "--step-by", "layer"],
+    )
+    .assert_ok();
+    let text = std::fs::read_to_string(out.join("house.ldr")).unwrap();
+    let report = read_report(&out);
+    let steps = report_u64(&report, "steps");
+    assert_eq!(count_steps(&text) as u64, steps);
+    assert!(
+        0 < steps && steps < pieces,
+        "--step-by layer: {steps} steps for {pieces} pieces"
+    );
+}
+
+/// A failed build: exit 2, one `error:` line naming `name`, no files.
+fn assert_fails_cleanly(tmp: &TempDir, run: &Run, name: &str, before: &[PathBuf]) {
+    run.assert_clean_error();
+    assert!(
+        run.stderr.contains(name),
+        "the error should name {name}\n{}",
+        run.describe()
+    );
+    assert_eq!(
+        files_under(tmp.path()),
+        before,
+        "a failed build must leave no files behind"
+    );
+}
+
+#[test]
+fn broken_inputs_fail_cleanly() {
+    let dir = fixture("broken");
+    let mut inputs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    inputs.sort();
+    assert!(inputs.len() >= 8, "fixtures/broken/ is incomplete");
+    inputs.push(fixture("no_such_file.obj"));
+    for input in inputs {
+        let tmp = tempdir();
+        let run = build(tmp.path(), &input, &tmp.path().join("out"), &[]);
+        let name = input.file_name().unwrap().to_str().unwrap();
+        assert_fails_cleanly(&tmp, &run, name, &[]);
+    }
+}
+
+#[test]
+fn a_malformed_rule_file_names_its_line() {
+    let tmp = tempdir();
+    let rules = tmp.path().join("bad.rules");
+    std::fs::write(&rules, "part 3005\nstart 3005\nrule 3005 oops\n").unwrap();
+    let run = build(
+        tmp.path(),
+        &fixture("box.obj"),
+        &tmp.path().join("out"),
+        &["--rules", s(&rules)],
+    );
+    assert_fails_cleanly(&tmp, &run, "bad.rules:3:", std::slice::from_ref(&rules));
+}
+
+#[test]
+fn bad_options_fail_without_a_panic() {
+    let input = fixture("box.obj");
+    for bad in [
+        &["--studs", "0"][..],
+        &["--studs", "100000"],
+        &["--height", "0"],
+        &["--studs", "-3"],
+        &["--time-budget", "0"],
+        &["--time-budget", "nan"],
+        &["--step-size", "0"],
+        &["--up", "x"],
+    ] {
+        let tmp = tempdir();
+        let out = tmp.path().join("out");
+        let mut args = vec!["build", s(&input), "-o", s(&out)];
+        args.extend_from_slice(bad);
+        let run = run_in(tmp.path(), &args);
+        // Clap's usage errors span several lines; ours are one line.
+        assert_eq!(run.code, Some(2), "{bad:?}\n{}", run.describe());
+        assert!(
+            run.stderr.starts_with("error: "),
+            "{bad:?}\n{}",
+            run.describe()
+        );
+        assert!(
+            !run.stderr.contains("panicked"),
+            "{bad:?}\n{}",
+            run.describe()
+        );
+        assert_eq!(files_under(tmp.path()), Vec::<PathBuf>::new(), "{bad:?}");
+    }
+}
+
+const BRICK: &str = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat";
+
+#[test]
+fn verify_finds_overlaps_and_floating_bricks() {
+    let tmp = tempdir();
+    let cases = [
+        (
+            "overlap.ldr",
+            format!("{BRICK}\n0 STEP\n{BRICK}\n0 STEP\n"),
+            "overlap",
+        ),
+        (
+            "floating.ldr",
+            // The second 2x4 is one brick height above the first: a gap.
+            format!("{BRICK}\n0 STEP\n1 4 40 -72 20 1 0 0 0 1 0 0 0 1 3001.dat\n0 STEP\n"),
+            "not stud-connected",
+        ),
+    ];
+    for (name, body, problem) in cases {
+        let path = tmp.path().join(name);
+        std::fs::write(&path, format!("0 bad model\n0 Name: {name}\n{body}")).unwrap();
+        let run = run_in(tmp.path(), &["verify", s(&path)]);
+        assert_eq!(run.code, Some(1), "{name}\n{}", run.describe());
+        assert!(run.stdout.contains(problem), "{name}\n{}", run.describe());
+    }
+
+    // A sound two-brick model passes.
+    let good = tmp.path().join("good.ldr");
+    let text = format!("{BRICK}\n0 STEP\n1 4 60 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n0 STEP\n");
+    std::fs::write(&good, text).unwrap();
+    run_in(tmp.path(), &["verify", s(&good)]).assert_ok();
+}
+
+#[test]
+fn verify_rejects_unreadable_files() {
+    let tmp = tempdir();
+    let garbage = tmp.path().join("garbage.ldr");
+    let bytes: Vec<u8> = (0..300u32).map(|i| (i * 37 % 251) as u8).collect();
+    std::fs::write(&garbage, bytes).unwrap();
+    let text = tmp.path().join("prose.ldr");
+    std::fs::write(&text, "hello world\nthis is not LDraw\n").unwrap();
+    for (path, name) in [
+        (garbage, "garbage.ldr"),
+        (text, "prose.ldr"),
+        (tmp.path().join("missing.ldr"), "missing.ldr"),
+    ] {
+        let run = run_in(tmp.path(), &["verify", s(&path)]);
+        run.assert_clean_error();
+        assert!(run.stderr.contains(name), "{}", run.describe());
+    }
+}
+
+#[test]
+fn generated_rule_files_load() {
+    let tmp = tempdir();
+    for alphabet in ["default", "extended"] {
+        let rules = tmp.path().join(format!("{alphabet}.rules"));
+        run_in(
+            tmp.path(),
+            &["rules", "--alphabet", alphabet, "-o", s(&rules)],
+        )
+        .assert_ok();
+        let stdout = run_in(tmp.path(), &["rules", "--alphabet", alphabet]);
+        stdout.assert_ok();
+        assert_eq!(std::fs::read_to_string(&rules).unwrap(), stdout.stdout);
+
+        let out = tmp.path().join(alphabet);
+        build(
+            tmp.path(),
+            &fixture("box.obj"),
+            &out,
+            &["--rules", s(&rules)],
+        )
+        .assert_ok();
+        run_in(tmp.path(), &["verify", s(&out.join("box.ldr"))]).assert_ok();
+    }
+}
+
+#[test]
+fn the_shipped_rule_files_load() {
+    let tmp = tempdir();
+    for name in ["default.rules", "extended.rules"] {
+        let rules = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("rules")
+            .join(name);
+        let out = tmp.path().join(name);
+        build(
+            tmp.path(),
+            &fixture("house.obj"),
+            &out,
+            &["--rules", s(&rules)],
+        )
+        .assert_ok();
+    }
+}
