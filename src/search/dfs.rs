@@ -219,8 +219,7 @@ impl<'a> PartSearch<'a> {
                 stats.starts += 1;
                 return PartResult::Built(t);
             }
-            if nodes_here >= max_nodes || (nodes_here % 256 == 0 && Instant::now() >= self.deadline)
-            {
+            if nodes_here >= max_nodes || Instant::now() >= self.deadline {
                 return PartResult::OutOfBudget;
             }
             let top = stack.last_mut().expect("root frame");
@@ -361,6 +360,9 @@ impl<'a> PartSearch<'a> {
                         let slot = slots[f.slot];
                         f.slot += 1;
                         stats.match_tries += 1;
+                        if stats.match_tries % 65_536 == 0 && Instant::now() >= self.deadline {
+                            return None;
+                        }
                         if let (Slot::Rule(i), Some((p, r, None))) = (slot, fit) {
                             // The new piece's shape does not fit here: skip
                             // the other rules adding the same shape.

@@ -154,7 +154,7 @@ pub(crate) fn grow(
                 .collect();
             return PartResult::Built(trace);
         }
-        if nodes % 256 == 0 && Instant::now() >= deadline {
+        if Instant::now() >= deadline {
             return PartResult::OutOfBudget;
         }
         if stack.last().is_none_or(|f| f.placed) {
@@ -192,6 +192,9 @@ pub(crate) fn grow(
                     let (ox, oy) = (f.corner as i32 % sx, f.corner as i32 / sx);
                     f.corner += 1;
                     stats.match_tries += 1;
+                    if stats.match_tries % 65_536 == 0 && Instant::now() >= deadline {
+                        return PartResult::OutOfBudget;
+                    }
                     let p = Placement::new(added, f.target.offset(-ox, -oy, 0), added_rot);
                     let b = boxed(&p);
                     if !v.all_set(&b) || cover.any_set(&b) {

@@ -4,7 +4,7 @@
 //! [`build`] takes the voxels and a [`RuleSet`] and returns the pieces in
 //! build order. It first repairs what no build can hold (floating islands),
 //! cuts the voxels at horizontal planes where the voxel count changes
-//! sharply, and traces each part backward in [`dfs`], bottom part first: a
+//! sharply, and traces each part backward (module `dfs`), bottom part first: a
 //! part's pieces may rest on the parts built before it. Every part's trace,
 //! replayed forward, adds each piece connected to one before it.
 
