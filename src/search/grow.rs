@@ -143,7 +143,6 @@ pub(crate) fn grow(
     }
     shapes.sort_by_key(|&(x, y)| (x * y, x, y));
     let mut stack: Vec<Frame> = Vec::new();
-    let mut nodes = 0u64;
     loop {
         let left = v.count() - cover.count();
         if left == 0 {
@@ -272,7 +271,6 @@ pub(crate) fn grow(
                     stats.starts += 1;
                 }
                 f.placed = true;
-                nodes += 1;
                 stats.nodes += 1;
                 stats.max_depth = stats.max_depth.max(placed.len() as u64);
                 // The child frame is made on the next turn.

@@ -28,6 +28,9 @@ use crate::voxel::VoxelGrid;
 use dfs::{PartResult, PartSearch};
 pub use hierarchy::{split_parts, Repairs};
 
+/// The most voxels a model may have: some 400,000 bricks.
+pub const MAX_VOXELS: usize = 2_000_000;
+
 /// Tuning of the search. Defaults follow the paper where it gives numbers.
 #[derive(Debug, Clone, Serialize)]
 pub struct SearchOptions {
@@ -114,6 +117,14 @@ pub enum SearchError {
     /// No voxels to build.
     #[error("nothing to build: the voxel model is empty")]
     Empty,
+    /// More voxels than a build of bricks can sensibly have.
+    #[error("the model is too big to build: {voxels} voxels, more than the limit of {limit}; use a smaller --studs or --height")]
+    TooBig {
+        /// Voxels in the model.
+        voxels: usize,
+        /// The limit, [`MAX_VOXELS`].
+        limit: usize,
+    },
     /// Budgets ran out.
     #[error("the search ran out of its budget ({nodes} nodes, {secs:.1} s) with {left} of {total} voxels unbuilt; try another --seed or a smaller size")]
     Budget {
@@ -149,6 +160,13 @@ pub fn build(
 ) -> Result<SearchOutcome, SearchError> {
     if voxels.is_empty() {
         return Err(SearchError::Empty);
+    }
+    let n = voxels.count();
+    if n > MAX_VOXELS {
+        return Err(SearchError::TooBig {
+            voxels: n,
+            limit: MAX_VOXELS,
+        });
     }
     let started = Instant::now();
     let deadline = started + opts.time_budget;
