@@ -85,8 +85,12 @@ pub(crate) struct PartSearch<'a> {
     opts: &'a SearchOptions,
     starts: Vec<(PartKind, Rot)>,
     footprints: Vec<(i32, i32)>,
-    /// Every variant, grouped by the new piece's shape.
-    by_shape: Vec<u32>,
+    /// Every rule (up rules and pieces on the built part; down rules; all
+    /// rules) grouped by the new piece's shape, with the index where each
+    /// slot's shape group ends.
+    wide_up: (Vec<Slot>, Vec<u32>),
+    wide_down: (Vec<Slot>, Vec<u32>),
+    wide_all: (Vec<Slot>, Vec<u32>),
     weights: Vec<f64>,
     deadline: Instant,
 }
@@ -123,12 +127,44 @@ impl<'a> PartSearch<'a> {
             let studs = |p: PartKind| std::cmp::Reverse(p.spec().studs());
             (studs(v.added), v.added, v.added_rot, studs(v.anchor), i)
         });
+        let group = |keep: &dyn Fn(Dir) -> bool| {
+            let slots: Vec<Slot> = by_shape
+                .iter()
+                .filter(|&&i| keep(rules.variants()[i as usize].dir))
+                .map(|&i| Slot::Rule(i))
+                .collect();
+            let shape = |s: &Slot| match *s {
+                Slot::Rule(i) => {
+                    let v = &rules.variants()[i as usize];
+                    (v.added, v.added_rot)
+                }
+                Slot::OnBuilt(p, r) => (p, r),
+            };
+            let mut ends = vec![slots.len() as u32; slots.len()];
+            for k in (0..slots.len().saturating_sub(1)).rev() {
+                ends[k] = if shape(&slots[k]) == shape(&slots[k + 1]) {
+                    ends[k + 1]
+                } else {
+                    k as u32 + 1
+                };
+            }
+            (slots, ends)
+        };
+        let mut wide_up = group(&|d| d == Dir::Up);
+        for &(p, r) in &starts {
+            wide_up.0.push(Slot::OnBuilt(p, r));
+            wide_up.1.push(wide_up.0.len() as u32);
+        }
+        let wide_down = group(&|d| d == Dir::Down);
+        let wide_all = group(&|_| true);
         PartSearch {
             rules,
             opts,
             starts,
             footprints,
-            by_shape,
+            wide_up,
+            wide_down,
+            wide_all,
             weights,
             deadline,
         }
@@ -300,24 +336,9 @@ impl<'a> PartSearch<'a> {
                 Phase::Done if f.widened => return None,
                 Phase::Done => {
                     // The sampled rules found nothing: b reaches its maximum,
-                    // every rule not yet tried.
-                    let tried: std::collections::HashSet<u32> =
-                        f.up.iter()
-                            .chain(&f.down)
-                            .filter_map(|s| match s {
-                                Slot::Rule(i) => Some(*i),
-                                Slot::OnBuilt(..) => None,
-                            })
-                            .collect();
+                    // every rule, grouped by the new piece's shape.
                     f.up.clear();
                     f.down.clear();
-                    let _ = &tried;
-                    for &i in &self.by_shape {
-                        match (self.rules.variants()[i as usize].dir, built) {
-                            (Dir::Down, true) => f.down.push(Slot::Rule(i)),
-                            _ => f.up.push(Slot::Rule(i)),
-                        }
-                    }
                     f.widened = true;
                     f.phase = Phase::Up;
                     f.pos = 0;
@@ -338,7 +359,13 @@ impl<'a> PartSearch<'a> {
                     } else {
                         &orders.1
                     };
-                    let slots = if f.phase == Phase::Up { &f.up } else { &f.down };
+                    let (slots, ends): (&[Slot], &[u32]) = match (f.widened, f.phase == Phase::Up) {
+                        (false, true) => (&f.up, &[]),
+                        (false, false) => (&f.down, &[]),
+                        (true, true) if built => (&self.wide_up.0, &self.wide_up.1),
+                        (true, true) => (&self.wide_all.0, &self.wide_all.1),
+                        (true, false) => (&self.wide_down.0, &self.wide_down.1),
+                    };
                     while f.pos < order.len() && !st.v.get(order[f.pos]) {
                         f.pos += 1;
                         f.slot = 0;
@@ -368,6 +395,9 @@ impl<'a> PartSearch<'a> {
                             // the other rules adding the same shape.
                             let v = &self.rules.variants()[i as usize];
                             if (v.added, v.added_rot) == (p, r) {
+                                if let Some(&end) = ends.get(f.slot - 1) {
+                                    f.slot = end as usize;
+                                }
                                 continue;
                             }
                         }
