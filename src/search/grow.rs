@@ -239,14 +239,14 @@ pub(crate) fn grow(
                 f.slot += 1;
                 f.corner = 0;
             }
-            let may_backtrack = backtracks_here < opts.max_backtracks_per_part && !at_root;
-            if f.widened && (f.relaxed || may_backtrack) {
+            if f.widened && f.relaxed {
                 break;
             }
             if f.widened {
-                // Past the backtracking budget: cover the voxel even if that
-                // strands a neighbour, rather than leave this one out.
+                // Every rule failed the look-ahead: cover the voxel even if
+                // that may strand a neighbour, rather than give up here.
                 f.relaxed = true;
+                f.slots = by_shape.clone();
                 f.slot = 0;
                 f.corner = 0;
                 continue;
@@ -289,20 +289,24 @@ pub(crate) fn grow(
                     }
                     continue;
                 }
-                if backtracks_here >= opts.max_backtracks_per_part || at_root {
+                let hopeless = !can_ever_cover(v, built, f.target, &shapes);
+                if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
                     let t = f.target;
                     if std::env::var_os("BW_DEBUG").is_some() {
                         eprintln!(
-                            "drop {t:?}: on built {}, covered above {}, below {}, in v above {} below {}, slots {} widened {}",
+                            "drop {t:?}: on built {}, covered above {}, below {}, in v above {} below {}, slots {} widened {} relaxed {} root {} backtracks {}",
                             on_built(t),
                             cover.get(t.offset(0, 0, 1)),
                             cover.get(t.offset(0, 0, -1)),
                             v.get(t.offset(0, 0, 1)),
                             v.get(t.offset(0, 0, -1)),
                             f.slots.len(),
-                            f.widened
+                            f.widened,
+                            f.relaxed,
+                            at_root,
+                            backtracks_here
                         );
                     }
                     v.set(t, false);
@@ -334,6 +338,37 @@ pub(crate) fn grow(
             }
         }
     }
+}
+
+/// Whether some piece over `u` fits the part's voxels and has a voxel of the
+/// part or of the built structure directly above or below: if not, no order
+/// of building can ever join `u`.
+fn can_ever_cover(v: &VoxelGrid, built: &VoxelGrid, u: Cell, shapes: &[(i32, i32)]) -> bool {
+    shapes.iter().any(|&(sx, sy)| {
+        (0..sy).any(|oy| {
+            (0..sx).any(|ox| {
+                let bx = CellBox {
+                    min: u.offset(-ox, -oy, 0),
+                    sx,
+                    sy,
+                    sz: 1,
+                };
+                let below = CellBox {
+                    min: bx.min.offset(0, 0, -1),
+                    ..bx
+                };
+                let above = CellBox {
+                    min: bx.min.offset(0, 0, 1),
+                    ..bx
+                };
+                v.all_set(&bx)
+                    && (v.any_set(&below)
+                        || v.any_set(&above)
+                        || built.any_set(&below)
+                        || built.any_set(&above))
+            })
+        })
+    })
 }
 
 /// The biggest starting piece that covers `seed` and fits the voxels.
