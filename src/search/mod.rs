@@ -183,7 +183,9 @@ pub fn build(
         let result = if built.is_empty() {
             grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
         } else {
-            let budget = (2 * part.count() as u64 + 1000).min(opts.max_nodes_per_part);
+            // About twice the pieces the part needs: enough when the trace
+            // goes straight through, and little lost when it does not.
+            let budget = (part.count() as u64 / 2 + 256).min(opts.max_nodes_per_part);
             match search.run(part.clone(), &built, budget, &mut rng, &mut stats) {
                 PartResult::Built(t) => PartResult::Built(t),
                 _ if Instant::now() < deadline => {
