@@ -97,29 +97,9 @@ pub(crate) struct PartSearch<'a> {
 
 impl<'a> PartSearch<'a> {
     pub fn new(rules: &'a RuleSet, opts: &'a SearchOptions, deadline: Instant) -> Self {
-        let mut starts = Vec::new();
-        for s in rules.starts() {
-            for rot in [Rot::R0, Rot::R90] {
-                let r = s.part.spec().canonical_rot(rot);
-                if !starts.contains(&(s.part, r)) {
-                    starts.push((s.part, r));
-                }
-            }
-        }
-        // Bigger pieces first, so a piece on the built part takes the most.
-        starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
+        let starts = super::start_shapes(rules);
         let weights = rules.variants().iter().map(|v| v.weight).collect();
-        let mut footprints: Vec<(i32, i32)> = Vec::new();
-        for p in rules.alphabet() {
-            for rot in [Rot::R0, Rot::R90] {
-                let f = p.spec().footprint(rot);
-                if !footprints.contains(&f) {
-                    footprints.push(f);
-                }
-            }
-        }
-        // Small footprints first: they fit most often.
-        footprints.sort_by_key(|&(x, y)| (x * y, x, y));
+        let footprints = super::footprints(rules);
         let mut by_shape: Vec<u32> = (0..rules.variants().len() as u32).collect();
         // Big new pieces first, then big anchors: fewer, bigger bricks.
         by_shape.sort_by_key(|&i| {

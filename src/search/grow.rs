@@ -86,16 +86,7 @@ pub(crate) fn grow(
     let mut owner = vec![NONE; v.len()];
     let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
 
-    let mut starts: Vec<(crate::catalog::PartKind, Rot)> = Vec::new();
-    for s in rules.starts() {
-        for rot in [Rot::R0, Rot::R90] {
-            let r = s.part.spec().canonical_rot(rot);
-            if !starts.contains(&(s.part, r)) {
-                starts.push((s.part, r));
-            }
-        }
-    }
-    starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
+    let starts = super::start_shapes(rules);
     let place = |p: &Placement, cover: &mut VoxelGrid, owner: &mut Vec<u32>, id: u32| {
         let b = boxed(p);
         cover.set_box(&b, true);
@@ -132,16 +123,7 @@ pub(crate) fn grow(
     if !built.is_empty() {
         by_shape.extend((0..starts.len() as u32).map(|k| n_rules + k));
     }
-    let mut shapes: Vec<(i32, i32)> = Vec::new();
-    for p in rules.alphabet() {
-        for rot in [Rot::R0, Rot::R90] {
-            let s = p.spec().footprint(rot);
-            if !shapes.contains(&s) {
-                shapes.push(s);
-            }
-        }
-    }
-    shapes.sort_by_key(|&(x, y)| (x * y, x, y));
+    let shapes = super::footprints(rules);
     let mut stack: Vec<Frame> = Vec::new();
     loop {
         let left = v.count() - cover.count();

@@ -235,6 +235,38 @@ pub fn build(
     })
 }
 
+/// The starting pieces of `rules`, one per distinct turn, biggest first (so
+/// a piece put down first, or on a built part, takes the most).
+pub(crate) fn start_shapes(rules: &RuleSet) -> Vec<(crate::catalog::PartKind, crate::geom::Rot)> {
+    let mut starts = Vec::new();
+    for s in rules.starts() {
+        for rot in [crate::geom::Rot::R0, crate::geom::Rot::R90] {
+            let r = s.part.spec().canonical_rot(rot);
+            if !starts.contains(&(s.part, r)) {
+                starts.push((s.part, r));
+            }
+        }
+    }
+    starts.sort_by_key(|(p, _)| std::cmp::Reverse(p.spec().studs()));
+    starts
+}
+
+/// The distinct footprints of the alphabet's pieces, smallest first (they
+/// fit most often).
+pub(crate) fn footprints(rules: &RuleSet) -> Vec<(i32, i32)> {
+    let mut out: Vec<(i32, i32)> = Vec::new();
+    for p in rules.alphabet() {
+        for rot in [crate::geom::Rot::R0, crate::geom::Rot::R90] {
+            let f = p.spec().footprint(rot);
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+    }
+    out.sort_by_key(|&(x, y)| (x * y, x, y));
+    out
+}
+
 /// The pieces of an outcome in build order.
 pub fn placements(outcome: &SearchOutcome) -> Vec<Placement> {
     outcome.order.iter().map(|r| r.piece).collect()
