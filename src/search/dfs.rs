@@ -168,6 +168,10 @@ impl<'a> PartSearch<'a> {
             keyed.truncate(b);
         }
         keyed.sort_by(|a, c| c.0.total_cmp(&a.0).then(a.1.cmp(&c.1)));
+        // The drawn rules are tried bigger new piece first (in the order
+        // drawn among equals): fewer, bigger bricks.
+        let studs = |i: u32| self.rules.variants()[i as usize].added.spec().studs();
+        keyed.sort_by_key(|&(_, i)| std::cmp::Reverse(studs(i)));
         let mut up = Vec::new();
         let mut down = Vec::new();
         for (_, i) in keyed {
