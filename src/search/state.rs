@@ -10,6 +10,9 @@ use crate::geom::{Cell, CellBox};
 use crate::grammar::{piece_box, RuleId, PLATES_PER_LAYER};
 use crate::voxel::VoxelGrid;
 
+/// Positions the placeability flood fill visits before it gives up.
+const MAX_FLOOD: usize = 4096;
+
 /// No committed piece owns the cell.
 pub(crate) const NONE: u32 = u32::MAX;
 
@@ -338,9 +341,16 @@ impl<'g> State<'g> {
         let mut queue = std::collections::VecDeque::new();
         seen[idx(b.min)] = true;
         queue.push_back(b.min);
+        let mut visited = 0usize;
         while let Some(p) = queue.pop_front() {
             if outside(p) {
                 return true;
+            }
+            // A path this long is no way a person would bring a brick in;
+            // refusing the match is safe (the verifier never sees it).
+            visited += 1;
+            if visited > MAX_FLOOD {
+                return false;
             }
             let free_here = !blocked(&at(p));
             if !free_here {
