@@ -54,6 +54,10 @@ struct Frame {
     phase: Phase,
     /// Scan position: index into the phase's cell order, and the slot.
     pos: usize,
+    /// Where the up scan starts in its cell order: where the parent's match
+    /// was, so the cells peeled already are not walked again; the scan wraps
+    /// around to the cells before it.
+    start: usize,
     slot: usize,
     deferred: Vec<Candidate>,
     /// Whether the node has widened to every rule after its sample ran dry.
@@ -195,6 +199,7 @@ impl<'a> PartSearch<'a> {
         total: usize,
         rng: &mut ChaCha8Rng,
         applied: Option<Removal>,
+        start: usize,
     ) -> Frame {
         let b = self.branching(st.v.count(), total);
         let (mut up, mut down) = self.sample(b, rng);
@@ -209,6 +214,7 @@ impl<'a> PartSearch<'a> {
             down,
             phase: Phase::Up,
             pos: 0,
+            start,
             slot: 0,
             deferred: Vec::new(),
             widened: false,
@@ -227,7 +233,7 @@ impl<'a> PartSearch<'a> {
         let total = v.count();
         let orders = scan_orders(&v, !built.is_empty());
         let mut st = State::new(v, built, self.footprints.clone());
-        let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None)];
+        let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None, 0)];
         let mut nodes_here = 0u64;
         loop {
             if st.v.is_empty() {
@@ -255,7 +261,12 @@ impl<'a> PartSearch<'a> {
                     );
                     nodes_here += 1;
                     stats.nodes += 1;
-                    let f = self.frame(&st, total, rng, Some(removal));
+                    let start = if top.phase == Phase::Up && orders.0.len() > 0 {
+                        (top.start + top.pos) % orders.0.len()
+                    } else {
+                        0
+                    };
+                    let f = self.frame(&st, total, rng, Some(removal), start);
                     stack.push(f);
                     if stack.len() as u64 > stats.max_depth && std::env::var_os("BW_DUMP").is_some()
                     {
@@ -350,7 +361,9 @@ impl<'a> PartSearch<'a> {
                         (true, true) => (&self.wide_all.0, &self.wide_all.1),
                         (true, false) => (&self.wide_down.0, &self.wide_down.1),
                     };
-                    while f.pos < order.len() && !st.v.get(order[f.pos]) {
+                    let shift = if f.phase == Phase::Up { f.start } else { 0 };
+                    let at = |pos: usize| order[(shift + pos) % order.len()];
+                    while f.pos < order.len() && !st.v.get(at(f.pos)) {
                         f.pos += 1;
                         f.slot = 0;
                     }
@@ -365,7 +378,7 @@ impl<'a> PartSearch<'a> {
                         f.slot = 0;
                         continue;
                     }
-                    let cell = order[f.pos];
+                    let cell = at(f.pos);
                     let mut fit: Option<(PartKind, Rot, Option<Option<u32>>)> = None;
                     while f.slot < slots.len() {
                         let slot = slots[f.slot];

@@ -153,11 +153,20 @@ impl VoxelGrid {
     pub fn set_box(&mut self, b: &CellBox, on: bool) {
         let m = b.max_excl();
         assert!(self.in_bounds(b.min) && self.in_bounds(m.offset(-1, -1, -1)));
+        // The masks are the same for every row of the box.
+        let mut masks = [(0usize, 0u64); 16];
+        let mut n = 0;
+        for (w, mask) in self.run_words(b.min.x, b.sx) {
+            if n == masks.len() {
+                break;
+            }
+            masks[n] = (w, mask);
+            n += 1;
+        }
         for z in b.min.z..m.z {
             for y in b.min.y..m.y {
                 let r = self.row(y, z);
-                let words: Vec<_> = self.run_words(b.min.x, b.sx).collect();
-                for (w, mask) in words {
+                for &(w, mask) in &masks[..n] {
                     if on {
                         self.bits[r + w] |= mask;
                     } else {
