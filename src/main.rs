@@ -94,7 +94,7 @@ struct BuildArgs {
     #[arg(long, value_enum)]
     step_by: Option<StepBy>,
     /// Give up the search after this many seconds.
-    #[arg(long, default_value_t = 120.0)]
+    #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
     /// Print nothing but errors.
     #[arg(short, long)]

@@ -7,7 +7,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use serde::Serialize;
 use thiserror::Error;
@@ -429,6 +429,3 @@ fn describe(opts: &BuildOptions) -> String {
     };
     format!("{size} --up {up} --seed {}{rules}{steps}", opts.search.seed)
 }
-
-/// A default budget that is generous for a person waiting at a terminal.
-pub const DEFAULT_TIME_BUDGET: Duration = Duration::from_secs(120);

@@ -49,7 +49,7 @@ pub struct SearchOptions {
     pub max_backtracks_per_part: u64,
     /// Layers a part may have before the hierarchy cuts it anyway. Default 6.
     pub max_part_layers: i32,
-    /// Wall-clock budget for the whole search. Default 120 s.
+    /// Wall-clock budget for the whole search. Default 300 s.
     pub time_budget: Duration,
 }
 
@@ -62,7 +62,7 @@ impl Default for SearchOptions {
             max_nodes_per_part: 20_000,
             max_backtracks_per_part: 256,
             max_part_layers: 6,
-            time_budget: Duration::from_secs(120),
+            time_budget: Duration::from_secs(300),
         }
     }
 }
