@@ -200,7 +200,7 @@ pub(crate) fn grow(
                         }
                         Anchor::Built
                     };
-                    if !placeable(&cover, built, &b) {
+                    if !super::state::placeable(&cover, built, &b) {
                         stats.rejected_placeable += 1;
                         continue;
                     }
@@ -443,24 +443,6 @@ fn sample(weights: &[f64], b: usize, rng: &mut ChaCha8Rng) -> Vec<u32> {
     }
     keyed.sort_by(|a, c| c.0.total_cmp(&a.0).then(a.1.cmp(&c.1)));
     keyed.into_iter().map(|(_, i)| i).collect()
-}
-
-/// Pressed straight down or straight up through cells not yet built.
-fn placeable(cover: &VoxelGrid, built: &VoxelGrid, b: &CellBox) -> bool {
-    let (_, _, nz) = cover.dims();
-    let top = b.min.z + b.sz;
-    let above = CellBox {
-        min: b.min.offset(0, 0, b.sz),
-        sz: (nz - top).max(1),
-        ..*b
-    };
-    let below = CellBox {
-        min: Cell::new(b.min.x, b.min.y, 0),
-        sz: b.min.z.max(1),
-        ..*b
-    };
-    let blocked = |bx: &CellBox| cover.any_set(bx) || built.any_set(bx);
-    top >= nz || !blocked(&above) || b.min.z == 0 || !blocked(&below)
 }
 
 /// Whether every uncovered voxel near `b` can still be covered in some

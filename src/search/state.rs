@@ -263,124 +263,10 @@ impl<'g> State<'g> {
         }
     }
 
-    /// The free-space check of the paper: after peeling `b` (already taken
-    /// out of `v`), can the piece be brought to its place at its turn in the
-    /// forward build, when `v` and the built structure stand? Straight down
-    /// or straight up first; otherwise a flood fill of the piece's box
-    /// through free space, sideways moves needing a layer of clearance above
-    /// and below (the half-voxel padding, rounded to the grid), the last move
-    /// vertical.
+    /// The free-space check of the paper for `b`, already peeled: see
+    /// [`placeable`].
     pub fn placeable(&self, b: &CellBox) -> bool {
-        let (_, _, nz) = self.v.dims();
-        let top = b.min.z + b.sz;
-        let above = CellBox {
-            min: b.min.offset(0, 0, b.sz),
-            sz: (nz - top).max(1),
-            ..*b
-        };
-        let below = CellBox {
-            min: Cell::new(b.min.x, b.min.y, 0),
-            sz: b.min.z.max(1),
-            ..*b
-        };
-        let blocked = |bx: &CellBox| self.v.any_set(bx) || self.built.any_set(bx);
-        if (top >= nz || !blocked(&above)) || (b.min.z == 0 || !blocked(&below)) {
-            return true;
-        }
-        // Held between something right above and something right below: no
-        // move at all is possible.
-        let just_above = CellBox {
-            min: b.min.offset(0, 0, b.sz),
-            sz: 1,
-            ..*b
-        };
-        let just_below = CellBox {
-            min: b.min.offset(0, 0, -1),
-            sz: 1,
-            ..*b
-        };
-        if blocked(&just_above) && blocked(&just_below) {
-            return false;
-        }
-        self.flood(b)
-    }
-
-    fn flood(&self, b: &CellBox) -> bool {
-        let (nx, ny, nz) = self.v.dims();
-        let (mx, my) = (b.sx + 1, b.sy + 1);
-        let (w, d, h) = (nx + 2 * mx, ny + 2 * my, nz + 2 * b.sz + 2);
-        let idx = |p: Cell| (((p.z + b.sz + 1) * d + (p.y + my)) * w + (p.x + mx)) as usize;
-        let inside = |p: Cell| {
-            p.x >= -mx
-                && p.y >= -my
-                && p.z >= -b.sz - 1
-                && p.x < nx + mx
-                && p.y < ny + my
-                && p.z < nz + b.sz + 1
-        };
-        let at = |p: Cell| CellBox { min: p, ..*b };
-        let blocked = |bx: &CellBox| self.v.any_set(bx) || self.built.any_set(bx);
-        let clear = |p: Cell| {
-            let bx = at(p);
-            let pad = CellBox {
-                min: p.offset(0, 0, -1),
-                sz: b.sz + 2,
-                ..*b
-            };
-            !blocked(&bx) && !blocked(&pad)
-        };
-        let outside = |p: Cell| {
-            p.x + b.sx <= 0
-                || p.y + b.sy <= 0
-                || p.z + b.sz <= 0
-                || p.x >= nx
-                || p.y >= ny
-                || p.z >= nz
-        };
-        let mut seen = vec![false; (w * d * h) as usize];
-        let mut queue = std::collections::VecDeque::new();
-        seen[idx(b.min)] = true;
-        queue.push_back(b.min);
-        let mut visited = 0usize;
-        while let Some(p) = queue.pop_front() {
-            if outside(p) {
-                return true;
-            }
-            // A path this long is no way a person would bring a brick in;
-            // refusing the match is safe (the verifier never sees it).
-            visited += 1;
-            if visited > MAX_FLOOD {
-                return false;
-            }
-            let free_here = !blocked(&at(p));
-            if !free_here {
-                continue;
-            }
-            let clear_here = clear(p);
-            for (dx, dy, dz) in [
-                (0, 0, 1),
-                (0, 0, -1),
-                (1, 0, 0),
-                (-1, 0, 0),
-                (0, 1, 0),
-                (0, -1, 0),
-            ] {
-                let q = p.offset(dx, dy, dz);
-                if !inside(q) || seen[idx(q)] {
-                    continue;
-                }
-                let ok = if dz != 0 {
-                    !blocked(&at(q))
-                } else {
-                    clear_here && clear(q)
-                };
-                if ok {
-                    seen[idx(q)] = true;
-                    queue.push_back(q);
-                }
-            }
-        }
-        false
+        placeable(&self.v, self.built, b)
     }
 
     /// A picture of the voxels left, layer by layer ('.' free, letters by
@@ -659,4 +545,118 @@ impl<'g> State<'g> {
 /// The box a placement fills in a brick grid.
 pub(crate) fn boxed(p: &Placement) -> CellBox {
     piece_box(p.part, p.rot, p.origin)
+}
+
+/// The free-space check of the paper: can the piece `b` be brought to its
+/// place at its turn in the forward build, when the cells of `v` and
+/// `built` stand? Straight down or straight up first; otherwise a flood fill
+/// of the piece's box through free space, sideways moves needing a layer of
+/// clearance above and below (the half-voxel padding, rounded to the grid),
+/// the last move vertical.
+pub(crate) fn placeable(v: &VoxelGrid, built: &VoxelGrid, b: &CellBox) -> bool {
+    let (_, _, nz) = v.dims();
+    let top = b.min.z + b.sz;
+    let above = CellBox {
+        min: b.min.offset(0, 0, b.sz),
+        sz: (nz - top).max(1),
+        ..*b
+    };
+    let below = CellBox {
+        min: Cell::new(b.min.x, b.min.y, 0),
+        sz: b.min.z.max(1),
+        ..*b
+    };
+    let blocked = |bx: &CellBox| v.any_set(bx) || built.any_set(bx);
+    if (top >= nz || !blocked(&above)) || (b.min.z == 0 || !blocked(&below)) {
+        return true;
+    }
+    // Held between something right above and something right below: no
+    // move at all is possible.
+    let just_above = CellBox {
+        min: b.min.offset(0, 0, b.sz),
+        sz: 1,
+        ..*b
+    };
+    let just_below = CellBox {
+        min: b.min.offset(0, 0, -1),
+        sz: 1,
+        ..*b
+    };
+    if blocked(&just_above) && blocked(&just_below) {
+        return false;
+    }
+    flood(v, built, b)
+}
+
+fn flood(v: &VoxelGrid, built: &VoxelGrid, b: &CellBox) -> bool {
+    let (nx, ny, nz) = v.dims();
+    let (mx, my) = (b.sx + 1, b.sy + 1);
+    let (w, d, h) = (nx + 2 * mx, ny + 2 * my, nz + 2 * b.sz + 2);
+    let idx = |p: Cell| (((p.z + b.sz + 1) * d + (p.y + my)) * w + (p.x + mx)) as usize;
+    let inside = |p: Cell| {
+        p.x >= -mx
+            && p.y >= -my
+            && p.z >= -b.sz - 1
+            && p.x < nx + mx
+            && p.y < ny + my
+            && p.z < nz + b.sz + 1
+    };
+    let at = |p: Cell| CellBox { min: p, ..*b };
+    let blocked = |bx: &CellBox| v.any_set(bx) || built.any_set(bx);
+    let clear = |p: Cell| {
+        let bx = at(p);
+        let pad = CellBox {
+            min: p.offset(0, 0, -1),
+            sz: b.sz + 2,
+            ..*b
+        };
+        !blocked(&bx) && !blocked(&pad)
+    };
+    let outside = |p: Cell| {
+        p.x + b.sx <= 0 || p.y + b.sy <= 0 || p.z + b.sz <= 0 || p.x >= nx || p.y >= ny || p.z >= nz
+    };
+    let mut seen = vec![false; (w * d * h) as usize];
+    let mut queue = std::collections::VecDeque::new();
+    seen[idx(b.min)] = true;
+    queue.push_back(b.min);
+    let mut visited = 0usize;
+    while let Some(p) = queue.pop_front() {
+        if outside(p) {
+            return true;
+        }
+        // A path this long is no way a person would bring a brick in;
+        // refusing the match is safe (the verifier never sees it).
+        visited += 1;
+        if visited > MAX_FLOOD {
+            return false;
+        }
+        let free_here = !blocked(&at(p));
+        if !free_here {
+            continue;
+        }
+        let clear_here = clear(p);
+        for (dx, dy, dz) in [
+            (0, 0, 1),
+            (0, 0, -1),
+            (1, 0, 0),
+            (-1, 0, 0),
+            (0, 1, 0),
+            (0, -1, 0),
+        ] {
+            let q = p.offset(dx, dy, dz);
+            if !inside(q) || seen[idx(q)] {
+                continue;
+            }
+            let ok = if dz != 0 {
+                !blocked(&at(q))
+            } else {
+                clear_here && clear(q)
+            };
+            if ok {
+                seen[idx(q)] = true;
+                queue.push_back(q);
+            }
+        }
+    }
+    false
 }
