@@ -261,7 +261,7 @@ impl<'a> PartSearch<'a> {
                     );
                     nodes_here += 1;
                     stats.nodes += 1;
-                    let start = if top.phase == Phase::Up && orders.0.len() > 0 {
+                    let start = if top.phase == Phase::Up && !orders.0.is_empty() {
                         (top.start + top.pos) % orders.0.len()
                     } else {
                         0
