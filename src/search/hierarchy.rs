@@ -24,10 +24,9 @@ pub struct Repairs {
     pub supported_islands: usize,
     /// Voxels added as supports.
     pub support_voxels: usize,
-    /// Voxels added over the bottom layer where it had nothing above: a
-    /// single layer of bricks cannot hold together, so the base is made two
-    /// layers thick.
-    pub base_voxels: usize,
+    /// Voxels added to make one-layer sheets two layers thick (bricks side by
+    /// side in one layer cannot hold together).
+    pub thickened_voxels: usize,
     /// Voxels left out because no rule could join them to the build.
     pub dropped_unbuildable: usize,
 }
@@ -142,22 +141,31 @@ pub fn repair_islands(v: &VoxelGrid) -> (VoxelGrid, Repairs) {
     (out, rep)
 }
 
-/// Makes the bottom layer two layers thick where it has nothing above:
-/// bricks side by side in one layer can only be joined by bricks above.
-pub fn thicken_base(v: &mut VoxelGrid, rep: &mut Repairs) {
-    let Some(b) = v.bounds() else { return };
+/// Makes one-layer sheets two layers thick: a voxel with nothing directly
+/// above or below it can only join a build through a brick that also covers
+/// a neighbour with something above or below, and a sheet one layer thick
+/// (the bottom layer of a model, a mug's floor, a fin) cannot hold together
+/// at all. Such voxels get the voxel above them (below, at the grid's top).
+pub fn thicken_sheets(v: &mut VoxelGrid, rep: &mut Repairs) {
     let (_, _, nz) = v.dims();
-    if nz < 2 || b.sz < 2 {
+    if nz < 2 {
         return;
     }
-    let z = b.min.z;
     let bare: Vec<Cell> = v
-        .layer_cells(z)
-        .filter(|c| !v.get(c.offset(0, 0, 1)))
+        .cells()
+        .filter(|c| !v.get(c.offset(0, 0, 1)) && !v.get(c.offset(0, 0, -1)))
         .collect();
     for c in bare {
-        v.set(c.offset(0, 0, 1), true);
-        rep.base_voxels += 1;
+        let up = c.offset(0, 0, 1);
+        let add = if v.in_bounds(up) {
+            up
+        } else {
+            c.offset(0, 0, -1)
+        };
+        if !v.get(add) {
+            v.set(add, true);
+            rep.thickened_voxels += 1;
+        }
     }
 }
 

@@ -171,7 +171,7 @@ pub fn build(
     let started = Instant::now();
     let deadline = started + opts.time_budget;
     let (mut fixed, mut repairs) = hierarchy::repair_islands(voxels);
-    hierarchy::thicken_base(&mut fixed, &mut repairs);
+    hierarchy::thicken_sheets(&mut fixed, &mut repairs);
     let mut parts = split_parts(&fixed, opts.max_part_layers);
     let mut stats = SearchStats::default();
     let (nx, ny, nz) = fixed.dims();
