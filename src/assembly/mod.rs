@@ -145,3 +145,33 @@ pub enum StepGrouping {
     /// A new step whenever the build moves to another layer.
     Layer,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assembly(n: usize) -> Assembly {
+        let part = PartKind::from_id("3005").unwrap();
+        let order: Vec<Placement> = (0..n)
+            .map(|i| Placement::new(part, Cell::new(0, 0, i as i32 / 3), Rot::R0))
+            .collect();
+        Assembly::from_order(&order, 3, Color::RED)
+    }
+
+    #[test]
+    fn auto_steps_stay_within_what_leocad_shows() {
+        let mut small = assembly(200);
+        small.regroup(StepGrouping::Auto);
+        assert_eq!(small.step_count(), 200);
+        let mut big = assembly(1000);
+        big.regroup(StepGrouping::Auto);
+        assert_eq!(big.step_count(), 250);
+        assert!(big.step_count() as usize <= MAX_STEPS);
+        let mut sized = assembly(10);
+        sized.regroup(StepGrouping::Size(4));
+        assert_eq!(sized.step_count(), 3);
+        let mut layers = assembly(9);
+        layers.regroup(StepGrouping::Layer);
+        assert_eq!(layers.step_count(), 3);
+    }
+}

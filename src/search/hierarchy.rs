@@ -309,6 +309,33 @@ mod tests {
     }
 
     #[test]
+    fn one_layer_sheets_get_a_second_layer() {
+        // A thick block with a one-layer fin sticking out at its top layer.
+        let mut g = grid_with(&[
+            CellBox {
+                min: Cell::new(0, 0, 0),
+                sx: 3,
+                sy: 3,
+                sz: 3,
+            },
+            CellBox {
+                min: Cell::new(3, 0, 2),
+                sx: 4,
+                sy: 1,
+                sz: 1,
+            },
+        ]);
+        let mut rep = Repairs::default();
+        thicken_sheets(&mut g, &mut rep);
+        assert_eq!(rep.thickened_voxels, 4);
+        assert!((3..7).all(|x| g.get(Cell::new(x, 0, 3))));
+        // Nothing bare is left, so a second pass changes nothing.
+        let before = g.clone();
+        thicken_sheets(&mut g, &mut rep);
+        assert_eq!(g, before);
+    }
+
+    #[test]
     fn parts_cut_where_the_count_changes_and_merge_when_they_cannot_rest() {
         // A wide base, a narrow tower: cut between them.
         let g = grid_with(&[
