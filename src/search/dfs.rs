@@ -14,7 +14,6 @@
 
 use std::time::Instant;
 
-use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::state::{boxed, Anchor, Removal, State};
@@ -157,28 +156,14 @@ impl<'a> PartSearch<'a> {
     /// Samples `b` distinct variants, weighted (Efraimidis–Spirakis keys),
     /// in the order drawn; split by direction.
     fn sample(&self, b: usize, rng: &mut ChaCha8Rng) -> (Vec<Slot>, Vec<Slot>) {
-        let mut keyed: Vec<(f64, u32)> = self
-            .weights
-            .iter()
-            .enumerate()
-            .map(|(i, &w)| {
-                let u: f64 = rng.gen_range(f64::EPSILON..1.0);
-                (u.ln() / w, i as u32)
-            })
-            .collect();
-        let b = b.min(keyed.len());
-        if b < keyed.len() {
-            keyed.select_nth_unstable_by(b, |a, c| c.0.total_cmp(&a.0));
-            keyed.truncate(b);
-        }
-        keyed.sort_by(|a, c| c.0.total_cmp(&a.0).then(a.1.cmp(&c.1)));
+        let mut keyed = super::grow::sample(&self.weights, b, rng);
         // The drawn rules are tried bigger new piece first (in the order
         // drawn among equals): fewer, bigger bricks.
         let studs = |i: u32| self.rules.variants()[i as usize].added.spec().studs();
-        keyed.sort_by_key(|&(_, i)| std::cmp::Reverse(studs(i)));
+        keyed.sort_by_key(|&i| std::cmp::Reverse(studs(i)));
         let mut up = Vec::new();
         let mut down = Vec::new();
-        for (_, i) in keyed {
+        for i in keyed {
             match self.rules.variants()[i as usize].dir {
                 Dir::Up => up.push(Slot::Rule(i)),
                 Dir::Down => down.push(Slot::Rule(i)),

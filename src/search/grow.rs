@@ -383,14 +383,7 @@ fn distances(v: &VoxelGrid, seeds: &[Cell]) -> Vec<u32> {
     }
     while let Some(c) = q.pop_front() {
         let dc = d[v.index(c)];
-        for n in [
-            c.offset(1, 0, 0),
-            c.offset(-1, 0, 0),
-            c.offset(0, 1, 0),
-            c.offset(0, -1, 0),
-            c.offset(0, 0, 1),
-            c.offset(0, 0, -1),
-        ] {
+        for n in super::hierarchy::neighbors6(c) {
             if v.get(n) && d[v.index(n)] == u32::MAX {
                 d[v.index(n)] = dc + 1;
                 q.push_back(n);
@@ -430,7 +423,9 @@ fn nearest_uncovered(
         .expect("an uncovered voxel")
 }
 
-fn sample(weights: &[f64], b: usize, rng: &mut ChaCha8Rng) -> Vec<u32> {
+/// Draws `b` distinct rule indices from the categorical distribution of
+/// `weights` (Efraimidis–Spirakis keys), in the order drawn.
+pub(crate) fn sample(weights: &[f64], b: usize, rng: &mut ChaCha8Rng) -> Vec<u32> {
     let mut keyed: Vec<(f64, u32)> = weights
         .iter()
         .enumerate()

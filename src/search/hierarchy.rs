@@ -43,7 +43,8 @@ impl Repairs {
 const MIN_ISLAND: usize = 4;
 const MIN_ISLAND_FRACTION: f64 = 0.002;
 
-fn neighbors6(c: Cell) -> [Cell; 6] {
+/// The six face neighbours of `c`.
+pub(crate) fn neighbors6(c: Cell) -> [Cell; 6] {
     [
         c.offset(1, 0, 0),
         c.offset(-1, 0, 0),
