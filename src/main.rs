@@ -163,6 +163,12 @@ fn run_build(a: BuildArgs) -> Result<()> {
             println!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
         }
         let rep = &r.repairs;
+        if rep.budget_left_out > 0 {
+            println!(
+                "  warning: the search ran out of time; the build stops below {} voxels it had no time for (raise --time-budget or lower --studs)",
+                rep.budget_left_out
+            );
+        }
         if !rep.is_empty() {
             println!(
                 "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make one-layer sheets two layers thick, {} voxels left out that no rule could join",

@@ -29,6 +29,9 @@ pub struct Repairs {
     pub thickened_voxels: usize,
     /// Voxels left out because no rule could join them to the build.
     pub dropped_unbuildable: usize,
+    /// Voxels of the parts the search had no time left for: the build stops
+    /// at the last part finished.
+    pub budget_left_out: usize,
 }
 
 impl Repairs {

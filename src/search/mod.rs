@@ -179,6 +179,7 @@ pub fn build(
     let mut order: Vec<Removal> = Vec::new();
     let search = PartSearch::new(rules, opts, deadline);
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    let mut finished = parts.len();
     for (i, part) in parts.iter_mut().enumerate() {
         let result = if built.is_empty() {
             grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
@@ -215,7 +216,7 @@ pub fn build(
                     order.push(*r);
                 }
             }
-            PartResult::Unbuildable | PartResult::OutOfBudget => {
+            PartResult::Unbuildable | PartResult::OutOfBudget if order.is_empty() => {
                 return Err(SearchError::Budget {
                     nodes: stats.nodes,
                     secs: started.elapsed().as_secs_f64(),
@@ -223,13 +224,34 @@ pub fn build(
                     total: fixed.count(),
                 });
             }
+            PartResult::Unbuildable | PartResult::OutOfBudget => {
+                // Out of time: the parts built so far are a connected,
+                // verified build on their own; the rest is left out and
+                // reported.
+                finished = i;
+                break;
+            }
         }
     }
+    if finished < parts.len() {
+        repairs.budget_left_out = parts[finished..].iter().map(|p| p.count()).sum();
+        parts.truncate(finished);
+    }
     stats.parts = parts.len() as u64;
-    repairs.dropped_unbuildable = fixed.count() - built.count();
+    // The voxels to build after every repair: the parts as the search left
+    // them. The verifier checks that the pieces cover exactly these.
+    let mut target = VoxelGrid::new(nx, ny, nz);
+    for part in &parts {
+        for z in 0..nz {
+            for c in part.layer_cells(z).collect::<Vec<_>>() {
+                target.set(c, true);
+            }
+        }
+    }
+    repairs.dropped_unbuildable = fixed.count() - target.count() - repairs.budget_left_out;
     Ok(SearchOutcome {
         order,
-        voxels: built,
+        voxels: target,
         repairs,
         stats,
     })
