@@ -167,6 +167,38 @@ impl CellBox {
             && o.min.y < self.min.y + self.sy
     }
 
+    /// The one-layer box directly below this one's footprint.
+    pub const fn layer_below(&self) -> CellBox {
+        CellBox {
+            min: self.min.offset(0, 0, -1),
+            sz: 1,
+            ..*self
+        }
+    }
+
+    /// The one-layer box directly above this one's footprint.
+    pub const fn layer_above(&self) -> CellBox {
+        CellBox {
+            min: self.min.offset(0, 0, self.sz),
+            sz: 1,
+            ..*self
+        }
+    }
+
+    /// Every one-layer box of the given footprints that covers `u`.
+    pub fn covering(u: Cell, footprints: &[(i32, i32)]) -> impl Iterator<Item = CellBox> + '_ {
+        footprints.iter().flat_map(move |&(sx, sy)| {
+            (0..sy).flat_map(move |oy| {
+                (0..sx).map(move |ox| CellBox {
+                    min: u.offset(-ox, -oy, 0),
+                    sx,
+                    sy,
+                    sz: 1,
+                })
+            })
+        })
+    }
+
     /// Every cell of the box, x fastest, then y, then z.
     pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
         let m = self.min;

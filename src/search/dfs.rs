@@ -236,14 +236,7 @@ impl<'a> PartSearch<'a> {
             let top = stack.last_mut().expect("root frame");
             match self.next_candidate(&mut st, top, &orders, stats) {
                 Some(c) => {
-                    let removal = st.apply(
-                        c.piece,
-                        &c.b,
-                        c.committed,
-                        c.anchor,
-                        c.anchor_box.as_ref().map(|(b, id)| (b, *id)),
-                        c.rule,
-                    );
+                    let removal = apply(&mut st, &c);
                     nodes_here += 1;
                     stats.nodes += 1;
                     let start = if top.phase == Phase::Up && !orders.0.is_empty() {
@@ -253,10 +246,6 @@ impl<'a> PartSearch<'a> {
                     };
                     let f = self.frame(&st, total, rng, Some(removal), start);
                     stack.push(f);
-                    if stack.len() as u64 > stats.max_depth && std::env::var_os("BW_DUMP").is_some()
-                    {
-                        eprintln!("depth {} via {:?}\n{}", stack.len(), c.piece, st.dump());
-                    }
                     stats.max_depth = stats.max_depth.max(stack.len() as u64);
                 }
                 None => {
@@ -481,14 +470,7 @@ impl<'a> PartSearch<'a> {
     /// The checks that need the removal applied: placeability and
     /// connectivity. Leaves the state unchanged.
     fn passes(&self, st: &mut State, c: &Candidate, stats: &mut SearchStats) -> bool {
-        let r = st.apply(
-            c.piece,
-            &c.b,
-            c.committed,
-            c.anchor,
-            c.anchor_box.as_ref().map(|(b, id)| (b, *id)),
-            c.rule,
-        );
+        let r = apply(st, c);
         let new_anchor = match c.anchor_box {
             Some((ab, None)) => Some(ab),
             _ => None,
@@ -537,4 +519,16 @@ fn scan_orders(v: &VoxelGrid, built: bool) -> (Vec<Cell>, Vec<Cell>) {
         down.clear();
     }
     (up, down)
+}
+
+/// Applies a candidate's reverse rule application to the state.
+fn apply(st: &mut State, c: &Candidate) -> Removal {
+    st.apply(
+        c.piece,
+        &c.b,
+        c.committed,
+        c.anchor,
+        c.anchor_box.as_ref().map(|(b, id)| (b, *id)),
+        c.rule,
+    )
 }

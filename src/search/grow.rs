@@ -19,7 +19,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::dfs::PartResult;
-use super::state::{boxed, Anchor, Removal};
+use super::state::{boxed, Anchor, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::geom::{Cell, CellBox, Rot};
@@ -276,21 +276,6 @@ pub(crate) fn grow(
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
                     let t = f.target;
-                    if std::env::var_os("BW_DEBUG").is_some() {
-                        eprintln!(
-                            "drop {t:?}: on built {}, covered above {}, below {}, in v above {} below {}, slots {} widened {} relaxed {} root {} backtracks {}",
-                            on_built(t),
-                            cover.get(t.offset(0, 0, 1)),
-                            cover.get(t.offset(0, 0, -1)),
-                            v.get(t.offset(0, 0, 1)),
-                            v.get(t.offset(0, 0, -1)),
-                            f.slots.len(),
-                            f.widened,
-                            f.relaxed,
-                            at_root,
-                            backtracks_here
-                        );
-                    }
                     v.set(t, false);
                     stats.dropped_unbuildable += 1;
                     stack.pop();
@@ -326,31 +311,8 @@ pub(crate) fn grow(
 /// part or of the built structure directly above or below: if not, no order
 /// of building can ever join `u`.
 fn can_ever_cover(v: &VoxelGrid, built: &VoxelGrid, u: Cell, shapes: &[(i32, i32)]) -> bool {
-    shapes.iter().any(|&(sx, sy)| {
-        (0..sy).any(|oy| {
-            (0..sx).any(|ox| {
-                let bx = CellBox {
-                    min: u.offset(-ox, -oy, 0),
-                    sx,
-                    sy,
-                    sz: 1,
-                };
-                let below = CellBox {
-                    min: bx.min.offset(0, 0, -1),
-                    ..bx
-                };
-                let above = CellBox {
-                    min: bx.min.offset(0, 0, 1),
-                    ..bx
-                };
-                v.all_set(&bx)
-                    && (v.any_set(&below)
-                        || v.any_set(&above)
-                        || built.any_set(&below)
-                        || built.any_set(&above))
-            })
-        })
-    })
+    CellBox::covering(u, shapes)
+        .any(|bx| v.all_set(&bx) && (State::touches(v, &bx) || State::touches(built, &bx)))
 }
 
 /// The biggest starting piece that covers `seed` and fits the voxels.
@@ -475,21 +437,11 @@ fn still_coverable(
             let support = |c: Cell| {
                 built.get(c) || (v.get(c) && (cover.get(c) || !w.contains(c) || ok[local(c)]))
             };
-            let coverable = shapes.iter().any(|&(sx, sy)| {
-                (0..sy).any(|oy| {
-                    (0..sx).any(|ox| {
-                        let bx = CellBox {
-                            min: u.offset(-ox, -oy, 0),
-                            sx,
-                            sy,
-                            sz: 1,
-                        };
-                        free(&bx)
-                            && bx
-                                .cells()
-                                .any(|c| support(c.offset(0, 0, -1)) || support(c.offset(0, 0, 1)))
-                    })
-                })
+            let coverable = CellBox::covering(u, shapes).any(|bx| {
+                free(&bx)
+                    && bx
+                        .cells()
+                        .any(|c| support(c.offset(0, 0, -1)) || support(c.offset(0, 0, 1)))
             });
             if coverable {
                 ok[local(u)] = true;

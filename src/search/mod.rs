@@ -196,19 +196,6 @@ pub fn build(
                 other => other,
             }
         };
-        if std::env::var_os("BW_DEBUG").is_some() {
-            eprintln!(
-                "part {i}: {} voxels, {:?}, {} built below: {}",
-                part.count(),
-                part.bounds(),
-                built.count(),
-                match &result {
-                    PartResult::Built(t) => format!("built {}", t.len()),
-                    PartResult::Unbuildable => "unbuildable".into(),
-                    PartResult::OutOfBudget => "out of budget".into(),
-                }
-            );
-        }
         match result {
             PartResult::Built(trace) => {
                 for r in trace.iter().rev() {

@@ -133,18 +133,8 @@ impl<'g> State<'g> {
     }
 
     /// Whether `b`'s footprint touches cells of `g` directly above or below.
-    fn touches(g: &VoxelGrid, b: &CellBox) -> bool {
-        let below = CellBox {
-            min: b.min.offset(0, 0, -1),
-            sz: 1,
-            ..*b
-        };
-        let above = CellBox {
-            min: b.min.offset(0, 0, b.sz),
-            sz: 1,
-            ..*b
-        };
-        g.any_set(&below) || g.any_set(&above)
+    pub(crate) fn touches(g: &VoxelGrid, b: &CellBox) -> bool {
+        g.any_set(&b.layer_below()) || g.any_set(&b.layer_above())
     }
 
     /// Whether any committed piece is still in the grid.
@@ -181,17 +171,7 @@ impl<'g> State<'g> {
         if Self::touches(&self.peeled, b) || self.touches_built(b) {
             return true;
         }
-        let below = CellBox {
-            min: b.min.offset(0, 0, -1),
-            sz: 1,
-            ..*b
-        };
-        let above = CellBox {
-            min: b.min.offset(0, 0, b.sz),
-            sz: 1,
-            ..*b
-        };
-        [below, above].iter().any(|n| {
+        [b.layer_below(), b.layer_above()].iter().any(|n| {
             n.cells()
                 .any(|c| self.v.in_bounds(c) && self.owner[self.v.index(c)] != NONE)
         })
@@ -267,33 +247,6 @@ impl<'g> State<'g> {
     /// [`placeable`].
     pub fn placeable(&self, b: &CellBox) -> bool {
         placeable(&self.v, self.built, b)
-    }
-
-    /// A picture of the voxels left, layer by layer ('.' free, letters by
-    /// committed piece), for debugging.
-    #[allow(dead_code)]
-    pub fn dump(&self) -> String {
-        let (nx, ny, nz) = self.v.dims();
-        let mut s = String::new();
-        for z in (0..nz).rev() {
-            s.push_str(&format!("z={z}\n"));
-            for y in 0..ny {
-                for x in 0..nx {
-                    let c = Cell::new(x, y, z);
-                    let ch = if !self.v.get(c) {
-                        ' '
-                    } else {
-                        match self.owner[self.v.index(c)] {
-                            NONE => '.',
-                            id => (b'a' + (id % 26) as u8) as char,
-                        }
-                    };
-                    s.push(ch);
-                }
-                s.push('\n');
-            }
-        }
-        s
     }
 
     fn horizontal_edge(&self, a: usize, b: usize) -> bool {
@@ -397,40 +350,11 @@ impl<'g> State<'g> {
     }
 
     fn coverable(&self, u: Cell) -> bool {
-        for &(sx, sy) in &self.footprints {
-            for oy in 0..sy {
-                for ox in 0..sx {
-                    let bx = CellBox {
-                        min: u.offset(-ox, -oy, 0),
-                        sx,
-                        sy,
-                        sz: 1,
-                    };
-                    if !self.v.all_set(&bx) {
-                        continue;
-                    }
-                    if bx.cells().any(|c| self.owner[self.v.index(c)] != NONE) {
-                        continue;
-                    }
-                    let below = CellBox {
-                        min: bx.min.offset(0, 0, -1),
-                        ..bx
-                    };
-                    let above = CellBox {
-                        min: bx.min.offset(0, 0, 1),
-                        ..bx
-                    };
-                    if self.v.any_set(&below)
-                        || self.v.any_set(&above)
-                        || self.built.any_set(&below)
-                        || self.built.any_set(&above)
-                    {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
+        CellBox::covering(u, &self.footprints).any(|bx| {
+            self.v.all_set(&bx)
+                && bx.cells().all(|c| self.owner[self.v.index(c)] == NONE)
+                && (Self::touches(&self.v, &bx) || Self::touches(self.built, &bx))
+        })
     }
 
     fn neighbors(&self, c: Cell) -> [Cell; 6] {
@@ -572,17 +496,7 @@ pub(crate) fn placeable(v: &VoxelGrid, built: &VoxelGrid, b: &CellBox) -> bool {
     }
     // Held between something right above and something right below: no
     // move at all is possible.
-    let just_above = CellBox {
-        min: b.min.offset(0, 0, b.sz),
-        sz: 1,
-        ..*b
-    };
-    let just_below = CellBox {
-        min: b.min.offset(0, 0, -1),
-        sz: 1,
-        ..*b
-    };
-    if blocked(&just_above) && blocked(&just_below) {
+    if blocked(&b.layer_above()) && blocked(&b.layer_below()) {
         return false;
     }
     flood(v, built, b)
