@@ -24,7 +24,7 @@ use crate::assembly::{Assembly, Placed, Placement, Step};
 use crate::catalog::{Color, PartKind};
 use crate::geom::{Cell, Rot};
 
-use super::{rot_matrix, LdrError, LDU_PER_PLATE, LDU_PER_STUD};
+use super::{origin_offset, rot_matrix, LdrError, LDU_PER_PLATE, LDU_PER_STUD};
 
 /// Most references (parts and submodels) one file may expand to.
 const MAX_EXPANDED: usize = 1_000_000;
@@ -42,8 +42,8 @@ const MATRIX_TOLERANCE: f64 = 1e-3;
 /// The colour code meaning "the colour of the referencing line".
 const INHERIT_COLOUR: Color = Color(16);
 
-/// Plates per voxel layer of the assemblies [`to_assembly`] builds (bricks).
-const BRICK_PLATES_PER_LAYER: u8 = 3;
+/// The finest vertical step, in LDU, a piece may sit at: half a plate.
+const Y_GRID_LDU: f64 = 4.0;
 
 /// One part reference of a flattened model.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,11 +120,21 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
 ///
 /// The cells are translated so that the lowest x, y and z over all pieces
 /// are 0. Steps are renumbered 1, 2, 3, ... in order, skipping steps with no
-/// pieces. The result uses 3 plates a layer (one brick a layer).
+/// pieces. The layers are as high as the pieces allow: a brick (24 LDU)
+/// for bricks on brick layers, 12 LDU with slopes or bricks offset by half
+/// a brick, 8 with plates, 4 with both.
 pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
     let mut raw = Vec::with_capacity(model.parts.len());
     for r in &model.parts {
         raw.push((to_placement(r, &model.path)?, r.step, r.color));
+    }
+    let low = raw.iter().map(|(p, _, _)| p.origin.z).min().unwrap_or(0);
+    let layer_ldu = raw.iter().fold(24, |g, (p, _, _)| {
+        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
+    });
+    for (p, _, _) in &mut raw {
+        // The reader leaves the bottom in LDU; make it a layer index.
+        p.origin.z = (p.origin.z - low) / layer_ldu;
     }
     let lo = raw
         .iter()
@@ -150,13 +160,19 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
             color,
         });
     }
-    Ok(Assembly {
-        pieces,
-        plates_per_layer: BRICK_PLATES_PER_LAYER,
-    })
+    Ok(Assembly { pieces, layer_ldu })
 }
 
-/// One reference's catalog part, rotation and raw (unshifted) grid cell.
+fn gcd(a: i32, b: i32) -> i32 {
+    if b == 0 {
+        a.abs()
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// One reference's catalog part, rotation and raw (unshifted) grid cell,
+/// with the height of its bottom above LDraw's `Y = 0`, in LDU, as `z`.
 fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
     let kind = PartKind::from_id(&r.part).ok_or_else(|| LdrError::UnknownPart {
         path: path.to_path_buf(),
@@ -172,7 +188,8 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
     let spec = kind.spec();
     let (sx, sy) = spec.footprint(rot);
     let stud = f64::from(LDU_PER_STUD);
-    let layer = f64::from(LDU_PER_PLATE) * f64::from(BRICK_PLATES_PER_LAYER);
+    let (ox, oz) = origin_offset(kind, rot);
+    let centre = [r.pos[0] - ox as f64, r.pos[2] - oz as f64];
     let height = f64::from(LDU_PER_PLATE) * f64::from(spec.height_plates);
     let off_grid = |axis: char, value: f64, why: String| LdrError::OffGrid {
         path: path.to_path_buf(),
@@ -183,7 +200,7 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
         why,
     };
     let turned = format!("{} turned {}", spec.id, rot.name());
-    let x = grid_index(r.pos[0] - stud / 2.0 * f64::from(sx), stud).map_err(|far| {
+    let x = grid_index(centre[0] - stud / 2.0 * f64::from(sx), stud).map_err(|far| {
         off_grid(
             'X',
             r.pos[0],
@@ -194,7 +211,7 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
             },
         )
     })?;
-    let y = grid_index(r.pos[2] - stud / 2.0 * f64::from(sy), stud).map_err(|far| {
+    let y = grid_index(centre[1] - stud / 2.0 * f64::from(sy), stud).map_err(|far| {
         off_grid(
             'Z',
             r.pos[2],
@@ -205,7 +222,7 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
             },
         )
     })?;
-    let z = grid_index(-r.pos[1] - height, layer).map_err(|far| {
+    let z = grid_index(-r.pos[1] - height, Y_GRID_LDU).map_err(|far| {
         off_grid(
             'Y',
             r.pos[1],
@@ -213,13 +230,13 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
                 format!("is too far from the origin (over {MAX_ABS_LDU} LDU)")
             } else {
                 format!(
-                    "but {} must sit at Y = -(24*n + {height}) to stand on a brick layer",
+                    "but {} must sit at Y = -(4*n + {height}) to stand on the plate grid",
                     spec.id
                 )
             },
         )
     })?;
-    Ok(Placement::new(kind, Cell::new(x, y, z), rot))
+    Ok(Placement::new(kind, Cell::new(x, y, z * Y_GRID_LDU as i32), rot))
 }
 
 /// `v / unit` as an integer if `v` is within the tolerance of a multiple of
