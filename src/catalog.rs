@@ -264,6 +264,37 @@ impl PartKind {
     }
 }
 
+/// The layer heights, in LDU, whose bodies [`PartKind::body`] caches.
+const CACHED_LAYERS: [i32; 4] = [24, 12, 8, 4];
+
+impl PartKind {
+    /// [`PartSpec::body`], from a table computed once per layer height (a
+    /// slope's rows take some arithmetic, and the search asks often).
+    pub fn body(self, rot: Rot, origin: Cell, layer_ldu: i32) -> Body {
+        use std::sync::OnceLock;
+        static TABLES: [OnceLock<Vec<Option<Body>>>; 4] =
+            [OnceLock::new(), OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        let Some(k) = CACHED_LAYERS.iter().position(|&u| u == layer_ldu) else {
+            return self.spec().body(rot, origin, layer_ldu);
+        };
+        let table = TABLES[k].get_or_init(|| {
+            PARTS
+                .iter()
+                .flat_map(|p| {
+                    Rot::ALL.into_iter().map(move |r| {
+                        (p.height_ldu() % layer_ldu == 0)
+                            .then(|| p.body(r, Cell::new(0, 0, 0), layer_ldu))
+                    })
+                })
+                .collect()
+        });
+        match table[self.0 as usize * 4 + rot.quarter_turns() as usize] {
+            Some(b) => b.moved(origin.x, origin.y, origin.z),
+            None => self.spec().body(rot, origin, layer_ldu),
+        }
+    }
+}
+
 impl fmt::Display for PartKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.spec().id)

@@ -39,7 +39,7 @@ impl Placement {
     /// The cells the piece fills and where it connects, in a grid of
     /// `layer_ldu`-high layers.
     pub fn body(&self, layer_ldu: i32) -> Body {
-        self.part.spec().body(self.rot, self.origin, layer_ldu)
+        self.part.body(self.rot, self.origin, layer_ldu)
     }
 }
 

@@ -207,7 +207,7 @@ impl RuleSet {
     /// The cells `part` fills turned by `rot` with its minimum corner at
     /// `at`, in this rule set's layers.
     pub fn body(&self, part: PartKind, rot: Rot, at: Cell) -> Body {
-        part.spec().body(rot, at, self.layer_ldu())
+        part.body(rot, at, self.layer_ldu())
     }
 
     /// Every rotation of every basic rule.

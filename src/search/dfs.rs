@@ -414,7 +414,7 @@ impl<'a> PartSearch<'a> {
     /// [`Body::key`]) at `cell`, and its body.
     fn at_key(&self, part: PartKind, rot: Rot, cell: Cell) -> (Placement, Body) {
         let u = self.rules.layer_ldu();
-        let k = part.spec().body(rot, Cell::new(0, 0, 0), u).key();
+        let k = part.body(rot, Cell::new(0, 0, 0), u).key();
         let p = Placement::new(part, cell.offset(-k.x, -k.y, -k.z), rot);
         (p, p.body(u))
     }

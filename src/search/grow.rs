@@ -172,7 +172,7 @@ pub(crate) fn grow(
                     starts[(si - n_rules) as usize]
                 };
                 // Every way the piece can lie over the target voxel.
-                let local = added.spec().body(added_rot, Cell::new(0, 0, 0), u);
+                let local = added.body(added_rot, Cell::new(0, 0, 0), u);
                 let corners = local.volume() as usize;
                 while f.corner < corners {
                     let o = local.cells().nth(f.corner).expect("a cell of the body");
