@@ -164,8 +164,9 @@ fn run_build(a: BuildArgs) -> Result<()> {
     if !a.quiet {
         let r = &out.report;
         println!(
-            "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks, verified",
-            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1], r.grid[2]
+            "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks high, verified",
+            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1],
+            fmt_bricks(r.grid[2], r.layer_ldu)
         );
         for p in &r.parts {
             println!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
@@ -190,6 +191,16 @@ fn run_build(a: BuildArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// A height of `layers` layers `layer_ldu` high, in bricks (24 LDU).
+fn fmt_bricks(layers: i32, layer_ldu: i32) -> String {
+    let ldu = layers * layer_ldu;
+    if ldu % 24 == 0 {
+        (ldu / 24).to_string()
+    } else {
+        format!("{:.2}", f64::from(ldu) / 24.0)
+    }
 }
 
 fn run_verify(file: PathBuf) -> Result<bool> {

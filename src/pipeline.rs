@@ -149,6 +149,9 @@ pub struct BuildReport {
     pub triangles: usize,
     /// Grid size in studs (x, y) and layers (z).
     pub grid: [i32; 3],
+    /// Height of a layer in LDU: 24 (a brick), 12 (with slopes), 8 (with
+    /// plates).
+    pub layer_ldu: i32,
     /// Voxels of the input after voxelization.
     pub voxels_input: usize,
     /// Voxels built (after repairs).
@@ -190,6 +193,10 @@ pub struct ReportOptions {
     pub seed: u64,
     /// Search budget, seconds.
     pub time_budget: f64,
+    /// Whether slopes were allowed.
+    pub slopes: bool,
+    /// Whether plates were allowed.
+    pub plates: bool,
 }
 
 /// Stage callbacks, for progress display.
@@ -361,9 +368,12 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             steps: step_name(opts.steps),
             seed: opts.search.seed,
             time_budget: opts.search.time_budget.as_secs_f64(),
+            slopes: opts.slopes,
+            plates: opts.plates,
         },
         triangles: mesh.triangles.len(),
         grid: [nx, ny, nz],
+        layer_ldu: rules.layer_ldu(),
         voxels_input: model.grid.count(),
         voxels,
         pieces,

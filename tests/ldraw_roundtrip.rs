@@ -46,10 +46,34 @@ fn every_part_in_every_rotation_round_trips() {
                 Placement::new(kind, Cell::new(3, 5, 2), rot),
                 Placement::new(kind, Cell::new(1, 0, 7), rot.then(Rot::R90)),
             ];
-            let asm = Assembly::from_order(&order, 3, Color(71));
+            let asm = Assembly::from_order(&order, 8, Color(71));
             assert_eq!(round_trip(&asm), asm, "{kind} {rot:?}");
         }
     }
+}
+
+/// Slopes on half-brick layers: their LDraw origin is on the back row, and
+/// the reader picks 12 LDU layers back.
+#[test]
+fn slopes_on_half_brick_layers_round_trip() {
+    let order = [
+        Placement::new(part("3001"), Cell::new(0, 0, 0), Rot::R0),
+        Placement::new(part("3039"), Cell::new(0, 0, 2), Rot::R90),
+        Placement::new(part("3298"), Cell::new(2, 0, 2), Rot::R180),
+        Placement::new(part("3004"), Cell::new(0, 0, 1), Rot::R270),
+        Placement::new(part("3665a"), Cell::new(5, 1, 3), Rot::R270),
+    ];
+    let asm = Assembly::from_order(&order, 12, Color(4));
+    let back = round_trip(&asm);
+    assert_eq!(back, asm);
+    assert_eq!(back.layer_ldu, 12);
+    // 3039 turned a quarter: the back row (LDraw +Z turned) lies at grid -x,
+    // so the origin sits 10 LDU from the footprint's centre toward -X.
+    let text = write(&asm);
+    assert!(
+        text.contains("1 4 10 -48 20 0 0 -1 0 1 0 1 0 0 3039.dat"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -65,7 +89,7 @@ fn reader_shifts_the_lowest_corner_to_zero_and_keeps_steps_and_colours() {
             p("3010", -2, 9, 4, Rot::R90, 1, 15),
             p("3003", 0, 12, 5, Rot::R0, 2, 1),
         ],
-        plates_per_layer: 3,
+        layer_ldu: 24,
     };
     let back = round_trip(&asm);
     let shifted: Vec<Placed> = asm
@@ -95,7 +119,7 @@ fn golden_assembly() -> Assembly {
             p("3010", 1, 1, 1, Rot::R0, 2, 15),
             p("3003", 4, 2, 1, Rot::R0, 2, 1),
         ],
-        plates_per_layer: 3,
+        layer_ldu: 24,
     }
 }
 
@@ -235,7 +259,7 @@ fn mpd_file_reads_into_one_assembly() {
         Placement::new(part("3001"), Cell::new(0, 0, 0), Rot::R0),
         Placement::new(part("3001"), Cell::new(0, 0, 1), Rot::R0),
     ];
-    let mut want = Assembly::from_order(&order, 3, Color(4));
+    let mut want = Assembly::from_order(&order, 24, Color(4));
     want.pieces[1].color = Color(15);
     assert_eq!(asm, want);
 }

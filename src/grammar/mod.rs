@@ -166,12 +166,18 @@ impl RuleSet {
     /// starting rule is left.
     pub fn restricted(&self, keep: impl Fn(PartKind) -> bool) -> Result<RuleSet, RuleError> {
         let alphabet: Vec<PartKind> = self.alphabet.iter().copied().filter(|&p| keep(p)).collect();
-        let starts: Vec<StartRule> = self.starts.iter().filter(|s| keep(s.part)).cloned().collect();
+        let starts: Vec<StartRule> = self
+            .starts
+            .iter()
+            .filter(|s| keep(s.part))
+            .cloned()
+            .collect();
         if starts.is_empty() {
             return Err(RuleError::File {
                 file: self.source.clone(),
-                message: "no starting rule is left for the parts asked for (see --slopes and --plates)"
-                    .into(),
+                message:
+                    "no starting rule is left for the parts asked for (see --slopes and --plates)"
+                        .into(),
             });
         }
         let rules = self
@@ -251,7 +257,11 @@ impl RuleSet {
                         r.added,
                         r.dx,
                         r.dy,
-                        if r.dir == Dir::Up { "on top" } else { "underneath" },
+                        if r.dir == Dir::Up {
+                            "on top"
+                        } else {
+                            "underneath"
+                        },
                         r.anchor
                     ),
                 ));

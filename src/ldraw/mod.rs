@@ -64,7 +64,7 @@
 //!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
 //!     Placement::new(brick, Cell::new(1, 0, 1), Rot::R90),
 //! ];
-//! let asm = Assembly::from_order(&order, 3, Color::RED);
+//! let asm = Assembly::from_order(&order, 24, Color::RED);
 //! let meta = LdrMeta {
 //!     title: "Two bricks".into(),
 //!     name: "two.ldr".into(),

@@ -236,7 +236,11 @@ fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
             },
         )
     })?;
-    Ok(Placement::new(kind, Cell::new(x, y, z * Y_GRID_LDU as i32), rot))
+    Ok(Placement::new(
+        kind,
+        Cell::new(x, y, z * Y_GRID_LDU as i32),
+        rot,
+    ))
 }
 
 /// `v / unit` as an integer if `v` is within the tolerance of a multiple of

@@ -325,11 +325,7 @@ mod tests {
     fn check(out: &SearchOutcome) {
         let (nx, ny, nz) = out.voxels.dims();
         let mut seen = VoxelGrid::new(nx, ny, nz);
-        let boxes: Vec<CellBox> = out
-            .order
-            .iter()
-            .map(|r| r.piece.body(24).bbox)
-            .collect();
+        let boxes: Vec<CellBox> = out.order.iter().map(|r| r.piece.body(24).bbox).collect();
         for (i, b) in boxes.iter().enumerate() {
             assert!(!seen.any_set(b), "piece {i} overlaps");
             seen.set_box(b, true);
@@ -458,7 +454,8 @@ mod part_tests {
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let voxels = g.count();
-            let PartResult::Built(trace) = search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
+            let PartResult::Built(trace) =
+                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
@@ -497,7 +494,8 @@ mod part_tests {
             let search = PartSearch::new(&rules, &o, Instant::now() + Duration::from_secs(60));
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let PartResult::Built(trace) = search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
+            let PartResult::Built(trace) =
+                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
