@@ -97,18 +97,21 @@ impl Assembly {
         let mut step = 0u32;
         let mut in_step = 0usize;
         let mut last_z = i32::MIN;
+        // Layers by brick course (24 LDU), whatever the grid's layer height.
+        let layer_ldu = self.layer_ldu;
+        let course = |p: &Placed| p.placement.origin.z * layer_ldu / 24;
         for p in &mut self.pieces {
             let new_step = match grouping {
                 StepGrouping::Each | StepGrouping::Auto => true,
                 StepGrouping::Size(n) => in_step >= n.max(1),
-                StepGrouping::Layer => p.placement.origin.z != last_z,
+                StepGrouping::Layer => course(p) != last_z,
             };
             if new_step || step == 0 {
                 step += 1;
                 in_step = 0;
             }
             in_step += 1;
-            last_z = p.placement.origin.z;
+            last_z = course(p);
             p.step = Step(step);
         }
     }
@@ -150,7 +153,7 @@ mod tests {
         let order: Vec<Placement> = (0..n)
             .map(|i| Placement::new(part, Cell::new(0, 0, i as i32 / 3), Rot::R0))
             .collect();
-        Assembly::from_order(&order, 3, Color::RED)
+        Assembly::from_order(&order, 24, Color::RED)
     }
 
     #[test]
