@@ -184,6 +184,12 @@ fn run_build(a: BuildArgs) -> Result<()> {
                 rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.dropped_unbuildable
             );
         }
+        println!(
+            "  seams: {} of {} vertical seams continue into the course above ({:.0}%; lower is stronger)",
+            r.seams.continued,
+            r.seams.seams,
+            100.0 * r.seams.fraction
+        );
         let s = &r.seconds;
         println!(
             "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, write {:.2}s",

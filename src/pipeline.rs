@@ -160,6 +160,8 @@ pub struct BuildReport {
     pub pieces: usize,
     /// Mean voxels per piece.
     pub voxels_per_piece: f64,
+    /// Vertical seams and how many continue into the course above.
+    pub seams: crate::assembly::metrics::SeamStats,
     /// Pieces by part.
     pub parts: Vec<PartCount>,
     /// Connected components of the finished build (1 when verified).
@@ -378,6 +380,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         voxels,
         pieces,
         voxels_per_piece: ((voxels as f64 / pieces.max(1) as f64) * 100.0).round() / 100.0,
+        seams: crate::assembly::metrics::seams(&assembly),
         parts: parts.into_values().collect(),
         components: 1,
         steps: assembly.step_count(),

@@ -4,6 +4,7 @@
 //! booklet back ends trust. It is produced by the search and checked by the
 //! independent [`verify`] module before anything is written.
 
+pub mod metrics;
 pub mod verify;
 
 use serde::Serialize;
