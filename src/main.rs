@@ -180,8 +180,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
         }
         if !rep.is_empty() {
             println!(
-                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make one-layer sheets two layers thick, {} voxels left out that no rule could join",
-                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.dropped_unbuildable
+                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make one-layer sheets two layers thick, {} voxels added to even flat tops to whole courses, {} voxels left out that no rule could join",
+                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.dropped_unbuildable
             );
         }
         println!(

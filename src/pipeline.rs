@@ -277,8 +277,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     progress.stage("searching");
     let t = Instant::now();
-    let outcome =
-        search::build(&model.grid, &rules, &opts.search).map_err(|reason| BuildError::Search {
+    let outcome = search::build_guided(&model.grid, Some(&model.slant), &rules, &opts.search)
+        .map_err(|reason| BuildError::Search {
             file: file.clone(),
             reason,
         })?;

@@ -44,7 +44,10 @@ pub fn seams(asm: &Assembly) -> SeamStats {
                 continue;
             }
             // Count a seam once, at the bottom layer of the pair.
-            let below = (owner.get(&c.offset(0, 0, -1)), owner.get(&n.offset(0, 0, -1)));
+            let below = (
+                owner.get(&c.offset(0, 0, -1)),
+                owner.get(&n.offset(0, 0, -1)),
+            );
             if below == (Some(&a), Some(&b)) {
                 continue;
             }
@@ -97,13 +100,20 @@ mod tests {
     #[test]
     fn stacked_seams_continue_and_running_bond_breaks_them() {
         // Stack bond: 1x4 on 1x4, the seam at x = 4 runs through.
-        let stack = wall(&[&[(0, "3010"), (4, "3010")], &[(0, "3010"), (4, "3010")]], 24, 1);
+        let stack = wall(
+            &[&[(0, "3010"), (4, "3010")], &[(0, "3010"), (4, "3010")]],
+            24,
+            1,
+        );
         let s = seams(&stack);
         assert_eq!((s.seams, s.continued), (1, 1));
         assert_eq!(s.fraction, 1.0);
         // Running bond: the course above is offset by two studs.
         let bond = wall(
-            &[&[(0, "3010"), (4, "3010")], &[(2, "3010"), (0, "3004"), (6, "3004")]],
+            &[
+                &[(0, "3010"), (4, "3010")],
+                &[(2, "3010"), (0, "3004"), (6, "3004")],
+            ],
             24,
             1,
         );
@@ -111,7 +121,11 @@ mod tests {
         assert_eq!((s.seams, s.continued), (1, 0));
         // The same stack on half-brick layers: bricks are two layers tall,
         // and the seam still counts once.
-        let half = wall(&[&[(0, "3010"), (4, "3010")], &[(0, "3010"), (4, "3010")]], 12, 2);
+        let half = wall(
+            &[&[(0, "3010"), (4, "3010")], &[(0, "3010"), (4, "3010")]],
+            12,
+            2,
+        );
         assert_eq!(seams(&half), seams(&stack));
     }
 }

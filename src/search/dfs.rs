@@ -22,7 +22,7 @@ use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
-use crate::voxel::VoxelGrid;
+use crate::voxel::{Slant, VoxelGrid};
 
 /// What one node may try at a cell.
 #[derive(Debug, Clone, Copy)]
@@ -213,6 +213,7 @@ impl<'a> PartSearch<'a> {
         v: VoxelGrid,
         built: &VoxelGrid,
         solid: &VoxelGrid,
+        slant: Option<&Slant>,
         max_nodes: u64,
         rng: &mut ChaCha8Rng,
         stats: &mut SearchStats,
@@ -223,6 +224,7 @@ impl<'a> PartSearch<'a> {
             v,
             built,
             solid,
+            slant,
             self.rules.layer_ldu(),
             self.footprints.clone(),
         );
@@ -288,7 +290,7 @@ impl<'a> PartSearch<'a> {
             if b.bbox != bounds {
                 continue;
             }
-            if st.is_single_piece(&p) && st.commitment(&b, &p).is_some() && st.face_clear(&b) {
+            if st.is_single_piece(&p) && st.commitment(&b, &p).is_some() && st.face_clear(&p, &b) {
                 return Some(Removal::new_start(p));
             }
         }
@@ -435,7 +437,7 @@ impl<'a> PartSearch<'a> {
                 let committed = match *fit {
                     Some((p, r, c)) if (p, r) == (v.added, v.added_rot) => c,
                     _ => {
-                        let c = if st.v.all_set_body(&b) && st.face_clear(&b) {
+                        let c = if st.v.all_set_body(&b) && st.face_clear(&piece, &b) {
                             st.commitment(&b, &piece)
                         } else {
                             None
@@ -448,7 +450,7 @@ impl<'a> PartSearch<'a> {
                 let a_at = piece.origin.offset(-dx, -dy, -dz);
                 let anchor = Placement::new(v.anchor, a_at, v.anchor_rot);
                 let a = anchor.body(st.layer_ldu);
-                if !st.v.all_set_body(&a) || !st.face_clear(&a) {
+                if !st.v.all_set_body(&a) || !st.face_clear(&anchor, &a) {
                     return None;
                 }
                 let a_committed = st.commitment(&a, &anchor)?;
@@ -463,7 +465,7 @@ impl<'a> PartSearch<'a> {
             }
             Slot::OnBuilt(part, rot) => {
                 let (piece, b) = self.at_key(part, rot, cell);
-                if !st.v.all_set_body(&b) || !st.touches_built(&b) || !st.face_clear(&b) {
+                if !st.v.all_set_body(&b) || !st.touches_built(&b) || !st.face_clear(&piece, &b) {
                     return None;
                 }
                 let committed = st.commitment(&b, &piece)?;

@@ -20,13 +20,13 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::dfs::PartResult;
-use super::state::{Anchor, Removal, State};
+use super::state::{face_fits, Anchor, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Body, Cell, CellBox, Rot};
+use crate::geom::{Cell, CellBox, Rot};
 use crate::grammar::RuleSet;
-use crate::voxel::VoxelGrid;
+use crate::voxel::{Slant, VoxelGrid};
 
 const NONE: u32 = u32::MAX;
 
@@ -57,6 +57,7 @@ pub(crate) fn grow(
     v: &mut VoxelGrid,
     built: &VoxelGrid,
     solid: &VoxelGrid,
+    slant: Option<&Slant>,
     rules: &RuleSet,
     opts: &SearchOptions,
     deadline: Instant,
@@ -109,7 +110,7 @@ pub(crate) fn grow(
     // the first piece, the next seed is tried.
     let mut seed_k = 0usize;
     if built.is_empty() {
-        let Some(first) = start_at(v, solid, u, &starts, seeds[0]) else {
+        let Some(first) = start_at(v, solid, slant, u, &starts, seeds[0]) else {
             return PartResult::Unbuildable;
         };
         place(&first, &mut cover, &mut owner, 0);
@@ -204,7 +205,7 @@ pub(crate) fn grow(
                                 let b = p.body(u);
                                 if !v.all_set_body(&b)
                                     || cover.any_set_body(&b)
-                                    || !face_clear(solid, built, &b)
+                                    || !face_fits(solid, built, slant, p, &b)
                                 {
                                     return false;
                                 }
@@ -306,13 +307,13 @@ pub(crate) fn grow(
                     cover.set_body(&p.body(u), false);
                     owner.iter_mut().for_each(|o| *o = NONE);
                     stack.clear();
-                    if let Some(first) = start_at(v, solid, u, &starts, seeds[seed_k]) {
+                    if let Some(first) = start_at(v, solid, slant, u, &starts, seeds[seed_k]) {
                         place(&first, &mut cover, &mut owner, 0);
                         placed.push((first, Anchor::Start, None));
                     }
                     continue;
                 }
-                let hopeless = !can_ever_cover(v, built, solid, u, f.target, &pieces);
+                let hopeless = !can_ever_cover(v, built, solid, slant, u, f.target, &pieces);
                 if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
@@ -355,6 +356,7 @@ fn can_ever_cover(
     v: &VoxelGrid,
     built: &VoxelGrid,
     solid: &VoxelGrid,
+    slant: Option<&Slant>,
     layer_ldu: i32,
     u: Cell,
     pieces: &[(PartKind, Rot)],
@@ -363,8 +365,9 @@ fn can_ever_cover(
         let local = part.body(rot, Cell::new(0, 0, 0), layer_ldu);
         let fits = local.cells().any(|o| {
             let b = local.moved(u.x - o.x, u.y - o.y, u.z - o.z);
+            let p = Placement::new(part, b.bbox.min, rot);
             v.all_set_body(&b)
-                && face_clear(solid, built, &b)
+                && face_fits(solid, built, slant, &p, &b)
                 && (State::links(v, &b) || State::links(built, &b))
         });
         fits
@@ -376,6 +379,7 @@ fn can_ever_cover(
 fn start_at(
     v: &VoxelGrid,
     solid: &VoxelGrid,
+    slant: Option<&Slant>,
     layer_ldu: i32,
     starts: &[(crate::catalog::PartKind, Rot)],
     seed: Cell,
@@ -387,22 +391,16 @@ fn start_at(
             for ox in 0..sx {
                 let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
                 let b = p.body(layer_ldu);
-                if b.contains(seed) && v.all_set_body(&b) && face_clear(solid, &nothing, &b) {
+                if b.contains(seed)
+                    && v.all_set_body(&b)
+                    && face_fits(solid, &nothing, slant, &p, &b)
+                {
                     return Some(p);
                 }
             }
         }
     }
     None
-}
-
-/// Whether a slope's sloping face, which passes through the cells of its
-/// box it does not fill, keeps clear of the model and the built structure.
-fn face_clear(solid: &VoxelGrid, built: &VoxelGrid, b: &Body) -> bool {
-    b.is_box()
-        || b.bbox
-            .cells()
-            .all(|c| b.contains(c) || (!solid.get(c) && !built.get(c)))
 }
 
 /// Breadth-first distances from `seed` through face-adjacent voxels.

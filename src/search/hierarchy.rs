@@ -11,7 +11,7 @@
 use serde::Serialize;
 
 use crate::geom::Cell;
-use crate::voxel::VoxelGrid;
+use crate::voxel::{Slant, VoxelGrid};
 
 /// What the repairs changed, for the report.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
@@ -27,6 +27,10 @@ pub struct Repairs {
     /// Voxels added to make one-layer sheets two layers thick (bricks side by
     /// side in one layer cannot hold together).
     pub thickened_voxels: usize,
+    /// Voxels added to bring flat tops up to a whole brick course (with
+    /// slopes, layers are half a brick, and a column half a course short
+    /// could only be filled by a slope).
+    pub evened_voxels: usize,
     /// Voxels left out because no rule could join them to the build.
     pub dropped_unbuildable: usize,
     /// Voxels of the parts the search had no time left for: the build stops
@@ -220,11 +224,52 @@ fn shortest_support(island: &[Cell], joined: &VoxelGrid, all: &VoxelGrid) -> Opt
     best
 }
 
+/// Makes every column run of `v` a whole number of `course` layers, by
+/// adding layers on top, except where the run's top cell lies on an
+/// up-facing slanted surface (`slant`): a slope's lower front row fills half
+/// a course there. Counted in `rep.evened_voxels`.
+pub fn even_courses(v: &mut VoxelGrid, slant: Option<&Slant>, course: i32, rep: &mut Repairs) {
+    if course < 2 {
+        return;
+    }
+    let (nx, ny, nz) = v.dims();
+    let slanted = |c: Cell| slant.is_some_and(|s| s.up.iter().any(|g| g.get(c)));
+    for y in 0..ny {
+        for x in 0..nx {
+            let mut z = 0;
+            while z < nz {
+                if !v.get(Cell::new(x, y, z)) {
+                    z += 1;
+                    continue;
+                }
+                let lo = z;
+                while z < nz && v.get(Cell::new(x, y, z)) {
+                    z += 1;
+                }
+                let short = (course - (z - lo) % course) % course;
+                let top = Cell::new(x, y, z - 1);
+                if short == 0 || slanted(top) || slanted(top.offset(0, 0, 1)) {
+                    continue;
+                }
+                let room = (z..z + short).all(|k| k < nz && !v.get(Cell::new(x, y, k)));
+                if room {
+                    for k in z..z + short {
+                        v.set(Cell::new(x, y, k), true);
+                        rep.evened_voxels += 1;
+                    }
+                    z += short;
+                }
+            }
+        }
+    }
+}
+
 /// Cuts `v` into parts at horizontal planes, bottom part first.
 ///
 /// A cut goes where the layer's voxel count differs from the layer below by
 /// more than half, or where a part would grow past `max_layers`, and above
-/// the second layer. A part some
+/// the second course (`course` layers make a brick course, and cuts fall
+/// between courses only). A part some
 /// of whose pieces could not touch the parts below it (or, for the bottom
 /// part, that is not in one piece) is merged with the part above.
 pub fn split_parts(v: &VoxelGrid, max_layers: i32, course: i32) -> Vec<VoxelGrid> {

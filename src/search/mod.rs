@@ -24,7 +24,7 @@ pub use state::{Anchor, Removal};
 
 use crate::assembly::Placement;
 use crate::grammar::RuleSet;
-use crate::voxel::VoxelGrid;
+use crate::voxel::{Slant, VoxelGrid};
 use dfs::{PartResult, PartSearch};
 pub use hierarchy::{split_parts, Repairs};
 
@@ -152,9 +152,21 @@ pub struct SearchOutcome {
     pub stats: SearchStats,
 }
 
-/// Finds an ordered, connected build of `voxels` with the rules `rules`.
+/// Finds an ordered, connected build of `voxels` with the rules `rules`;
+/// slopes go wherever their cells fit.
 pub fn build(
     voxels: &VoxelGrid,
+    rules: &RuleSet,
+    opts: &SearchOptions,
+) -> Result<SearchOutcome, SearchError> {
+    build_guided(voxels, None, rules, opts)
+}
+
+/// [`build`], with slopes only where the mesh's surface slants their way
+/// (`slant`, from the voxelizer), when given.
+pub fn build_guided(
+    voxels: &VoxelGrid,
+    slant: Option<&Slant>,
     rules: &RuleSet,
     opts: &SearchOptions,
 ) -> Result<SearchOutcome, SearchError> {
@@ -178,6 +190,9 @@ pub fn build(
     let plates = rules.layer_ldu() == 8;
     let min_thick = if plates { 2 } else { 2 * course };
     hierarchy::thicken_sheets(&mut fixed, &mut repairs, min_thick);
+    if !plates {
+        hierarchy::even_courses(&mut fixed, slant, course, &mut repairs);
+    }
     let mut parts = split_parts(&fixed, opts.max_part_layers, course);
     let mut stats = SearchStats::default();
     let (nx, ny, nz) = fixed.dims();
@@ -189,18 +204,26 @@ pub fn build(
     for (i, part) in parts.iter_mut().enumerate() {
         let result = if built.is_empty() {
             grow::grow(
-                part, &built, &fixed, rules, opts, deadline, &mut rng, &mut stats,
+                part, &built, &fixed, slant, rules, opts, deadline, &mut rng, &mut stats,
             )
         } else {
             // About twice the pieces the part needs: enough when the trace
             // goes straight through, and little lost when it does not.
             let budget = (part.count() as u64 / 2 + 256).min(opts.max_nodes_per_part);
-            match search.run(part.clone(), &built, &fixed, budget, &mut rng, &mut stats) {
+            match search.run(
+                part.clone(),
+                &built,
+                &fixed,
+                slant,
+                budget,
+                &mut rng,
+                &mut stats,
+            ) {
                 PartResult::Built(t) => PartResult::Built(t),
                 _ if Instant::now() < deadline => {
                     stats.fallbacks += 1;
                     grow::grow(
-                        part, &built, &fixed, rules, opts, deadline, &mut rng, &mut stats,
+                        part, &built, &fixed, slant, rules, opts, deadline, &mut rng, &mut stats,
                     )
                 }
                 other => other,
@@ -455,7 +478,7 @@ mod part_tests {
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let voxels = g.count();
             let PartResult::Built(trace) =
-                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
+                search.run(g.clone(), &built, &g, None, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
@@ -495,7 +518,7 @@ mod part_tests {
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let PartResult::Built(trace) =
-                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
+                search.run(g.clone(), &built, &g, None, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
@@ -531,6 +554,7 @@ mod part_tests {
                 &mut g,
                 &built,
                 &solid,
+                None,
                 &rules,
                 &o,
                 Instant::now() + Duration::from_secs(60),

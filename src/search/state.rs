@@ -6,9 +6,10 @@
 //! path applied, and undoing a removal restores the parent.
 
 use crate::assembly::Placement;
+use crate::catalog::Shape;
 use crate::geom::{Body, Cell, CellBox};
 use crate::grammar::RuleId;
-use crate::voxel::VoxelGrid;
+use crate::voxel::{Slant, VoxelGrid};
 
 /// Positions the placeability flood fill visits before it gives up.
 const MAX_FLOOD: usize = 4096;
@@ -81,6 +82,8 @@ pub(crate) struct State<'g> {
     solid: &'g VoxelGrid,
     /// Height of a layer in LDU.
     pub layer_ldu: i32,
+    /// Where the mesh's surface slants, when known.
+    slant: Option<&'g Slant>,
     /// Committed piece per cell (or [`NONE`]).
     owner: Vec<u32>,
     /// Committed pieces; `alive` is false once peeled.
@@ -101,6 +104,7 @@ impl<'g> State<'g> {
         v: VoxelGrid,
         built: &'g VoxelGrid,
         solid: &'g VoxelGrid,
+        slant: Option<&'g Slant>,
         layer_ldu: i32,
         footprints: Vec<(i32, i32)>,
     ) -> Self {
@@ -111,6 +115,7 @@ impl<'g> State<'g> {
             built,
             solid,
             layer_ldu,
+            slant,
             owner: vec![NONE; len],
             pieces: Vec::new(),
             peeled: VoxelGrid::new(nx, ny, nz),
@@ -156,13 +161,9 @@ impl<'g> State<'g> {
         g.any_set(&b.under_tubes()) || g.any_set(&b.over_studs())
     }
 
-    /// Whether a slope's sloping face, which passes through the cells of
-    /// its box it does not fill, keeps clear of every voxel of the model.
-    pub fn face_clear(&self, b: &Body) -> bool {
-        b.is_box()
-            || b.bbox
-                .cells()
-                .all(|c| b.contains(c) || (!self.solid.get(c) && !self.built.get(c)))
+    /// Whether a slope's sloping face fits here: see [`face_fits`].
+    pub fn face_clear(&self, p: &Placement, b: &Body) -> bool {
+        face_fits(self.solid, self.built, self.slant, p, b)
     }
 
     /// Whether any committed piece is still in the grid.
@@ -492,6 +493,41 @@ impl<'g> State<'g> {
         let b = p.body(self.layer_ldu);
         self.v.count() == b.volume() as usize && self.v.all_set_body(&b)
     }
+}
+
+/// Whether a slope's sloping face fits where `b` puts it: the face passes
+/// through the cells of its box the slope does not fill, so those must be
+/// clear of the model (`solid`) and the structure `built`; and where the
+/// mesh's surface is known (`slant`), it must slant there the way the slope
+/// faces (up and toward the slope's front for a slope, down for an inverted
+/// one), in those cells or the slope's own cells next to them. Bricks and
+/// plates always fit.
+pub(crate) fn face_fits(
+    solid: &VoxelGrid,
+    built: &VoxelGrid,
+    slant: Option<&Slant>,
+    p: &Placement,
+    b: &Body,
+) -> bool {
+    if b.is_box() {
+        return true;
+    }
+    let open = || b.bbox.cells().filter(|&c| !b.contains(c));
+    if !open().all(|c| !solid.get(c) && !built.get(c)) {
+        return false;
+    }
+    let Some(slant) = slant else {
+        return true;
+    };
+    let spec = p.part.spec();
+    let (bx, by) = spec.back(p.rot);
+    let up = spec.shape == Shape::Slope;
+    let Some(g) = slant.facing((-bx, -by), up) else {
+        return true;
+    };
+    let inward = if up { -1 } else { 1 };
+    let found = open().any(|c| g.get(c) || g.get(c.offset(0, 0, inward)));
+    found
 }
 
 /// The free-space check of the paper: can the piece `b` be brought to its

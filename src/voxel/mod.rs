@@ -7,5 +7,5 @@ pub mod voxelize;
 
 pub use grid::VoxelGrid;
 pub use voxelize::{
-    to_grid_frame, voxelize, Sizing, Up, VoxelModel, VoxelizeError, VoxelizeOptions,
+    to_grid_frame, voxelize, Sizing, Slant, Up, VoxelModel, VoxelizeError, VoxelizeOptions,
 };

@@ -171,6 +171,97 @@ pub struct VoxelModel {
     /// The grid's `(0, 0, 0)` corner, in input units in the grid frame
     /// (the input turned by [`to_grid_frame`]).
     pub origin: Vec3,
+    /// Where the surface slants, and which way it faces: what a slope
+    /// needs to be placed there.
+    pub slant: Slant,
+}
+
+/// The cells the mesh's surface passes through where it slants, by the way
+/// it faces: `up[d]` for a surface facing up and toward horizontal
+/// direction `d` (a roof: where a slope goes), `down[d]` for one facing down
+/// and toward `d` (an overhang: where an inverted slope goes). Directions
+/// are [`Slant::DIRS`]: `+x, -x, +y, -y` in the grid.
+///
+/// A face slants when its normal is between about 15 and 75 degrees from
+/// the vertical; a face leaning diagonally marks both of its directions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slant {
+    /// Up-facing slanted surface cells, by direction.
+    pub up: [VoxelGrid; 4],
+    /// Down-facing slanted surface cells, by direction.
+    pub down: [VoxelGrid; 4],
+}
+
+impl Slant {
+    /// The four horizontal directions, in the order of the grids.
+    pub const DIRS: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
+
+    /// No slanted surface anywhere, for grids of `dims`.
+    pub fn none(dims: (i32, i32, i32)) -> Slant {
+        let g = VoxelGrid::new(dims.0, dims.1, dims.2);
+        Slant {
+            up: std::array::from_fn(|_| g.clone()),
+            down: std::array::from_fn(|_| g.clone()),
+        }
+    }
+
+    /// The grid of surface cells facing `dir` (one of [`Slant::DIRS`]),
+    /// up-facing or down-facing.
+    pub fn facing(&self, dir: (i32, i32), up: bool) -> Option<&VoxelGrid> {
+        let k = Slant::DIRS.iter().position(|&d| d == dir)?;
+        Some(if up { &self.up[k] } else { &self.down[k] })
+    }
+
+    /// Marks the cells the triangles (in cell units) pass through where
+    /// they slant.
+    fn mark(tris: &[[DVec3; 3]], real: &[[DVec3; 3]], dims: (i32, i32, i32)) -> Slant {
+        let mut out = Slant::none(dims);
+        for (t, w) in tris.iter().zip(real) {
+            // The facing in real units (cells are taller than wide).
+            let n = (w[1] - w[0]).cross(w[2] - w[0]);
+            let len = n.length();
+            if !(len > 0.0) {
+                continue;
+            }
+            let n = n / len;
+            let vertical = n.z.abs();
+            if !(0.26..=0.97).contains(&vertical) {
+                continue;
+            }
+            let h = (n.x * n.x + n.y * n.y).sqrt();
+            let grids = if n.z > 0.0 {
+                &mut out.up
+            } else {
+                &mut out.down
+            };
+            let mut dirs = Vec::new();
+            for (k, &(dx, dy)) in Slant::DIRS.iter().enumerate() {
+                if (f64::from(dx) * n.x + f64::from(dy) * n.y) / h > 0.38 {
+                    dirs.push(k);
+                }
+            }
+            // Sample the triangle every half cell or finer.
+            let span = (t[1] - t[0])
+                .length()
+                .max((t[2] - t[0]).length())
+                .max((t[2] - t[1]).length());
+            let steps = (span * 2.0).ceil().clamp(1.0, 4096.0) as usize;
+            for i in 0..=steps {
+                for j in 0..=(steps - i) {
+                    let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                    let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+                    let c = Cell::new(p.x.floor() as i32, p.y.floor() as i32, p.z.floor() as i32);
+                    if !grids[0].in_bounds(c) {
+                        continue;
+                    }
+                    for &k in &dirs {
+                        grids[k].set(c, true);
+                    }
+                }
+            }
+        }
+        out
+    }
 }
 
 impl VoxelModel {
@@ -288,20 +379,26 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
     if nx > side || ny > side || nz > side || nx * ny * nz > MAX_CELLS {
         return Err(VoxelizeError::TooLarge { nx, ny, nz });
     }
-    let dims = [nx as usize, ny as usize, nz as usize];
     // Centre the shape in the grid's leftover fraction of a cell.
     let origin = lo - (cells * cell - ext) * 0.5;
+    // Room on top for whole brick courses: a grid of half-brick layers
+    // gets an empty layer over an odd count, so a flat top can be evened up.
+    let course = (24 / opts.layer_ldu.clamp(1, 24)) as u64;
+    let nz = nz.div_ceil(course) * course;
+    let dims = [nx as usize, ny as usize, nz as usize];
     let scaled: Vec<[DVec3; 3]> = tris
         .iter()
         .map(|t| t.map(|p| (p - origin) / cell))
         .collect();
 
     let grid = fill(&scaled, dims);
+    let slant = Slant::mark(&scaled, &tris, grid.dims());
     Ok(VoxelModel {
         grid,
         stud_size: stud as f32,
         layer_height_studs: ratio as f32,
         origin: origin.as_vec3(),
+        slant,
     })
 }
 
