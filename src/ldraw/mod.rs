@@ -88,7 +88,7 @@ use thiserror::Error;
 use crate::assembly::Placement;
 use crate::geom::Rot;
 
-pub use read::{parse_ldr, read_ldr, to_assembly, LdrModel, PartRef};
+pub use read::{parse_ldr, read_ldr, to_assembly, to_placement, Instance, LdrModel, PartRef};
 pub use write::{write_ldr, LdrMeta};
 
 #[cfg(doc)]
