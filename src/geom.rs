@@ -207,3 +207,153 @@ impl CellBox {
         })
     }
 }
+
+impl CellBox {
+    /// The box turned by `rot` about the vertical axis through the origin
+    /// (cell corners turn, so a box `[0, 2) x [0, 1)` turned a quarter is
+    /// `[-1, 0) x [0, 2)`).
+    pub const fn turned(&self, rot: Rot) -> CellBox {
+        let (x0, y0) = (self.min.x, self.min.y);
+        let (x1, y1) = (self.min.x + self.sx, self.min.y + self.sy);
+        let (ax, ay) = rot.apply(x0, y0);
+        let (bx, by) = rot.apply(x1, y1);
+        CellBox {
+            min: Cell::new(
+                if ax < bx { ax } else { bx },
+                if ay < by { ay } else { by },
+                self.min.z,
+            ),
+            sx: (ax - bx).abs(),
+            sy: (ay - by).abs(),
+            sz: self.sz,
+        }
+    }
+
+    /// The box moved by `(dx, dy, dz)`.
+    pub const fn moved(&self, dx: i32, dy: i32, dz: i32) -> CellBox {
+        CellBox {
+            min: self.min.offset(dx, dy, dz),
+            ..*self
+        }
+    }
+}
+
+/// Most boxes a [`Body`] is made of: one per distinct row height.
+pub const MAX_BODY_BOXES: usize = 3;
+
+/// The cells one placed piece fills and where it connects: a union of at
+/// most [`MAX_BODY_BOXES`] disjoint boxes (one for a brick or plate, one
+/// per terrace of a slope), bottom box first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Body {
+    boxes: [CellBox; MAX_BODY_BOXES],
+    n: u8,
+    /// The bounding box: what the piece takes up in space (a slope's
+    /// sloping face passes through the cells of its box it does not fill).
+    pub bbox: CellBox,
+    /// The top-layer cells that carry studs.
+    pub studs: CellBox,
+    /// The bottom-layer cells that take studs from below.
+    pub tubes: CellBox,
+}
+
+impl Body {
+    /// A body from its boxes (bottom first), bounding box and connection
+    /// boxes.
+    pub fn new(boxes: &[CellBox], bbox: CellBox, studs: CellBox, tubes: CellBox) -> Body {
+        assert!(!boxes.is_empty() && boxes.len() <= MAX_BODY_BOXES);
+        let mut b = [boxes[0]; MAX_BODY_BOXES];
+        b[..boxes.len()].copy_from_slice(boxes);
+        Body {
+            boxes: b,
+            n: boxes.len() as u8,
+            bbox,
+            studs,
+            tubes,
+        }
+    }
+
+    /// A plain box: a brick or plate.
+    pub fn solid(b: CellBox) -> Body {
+        Body::new(
+            &[b],
+            b,
+            CellBox {
+                min: b.min.offset(0, 0, b.sz - 1),
+                sz: 1,
+                ..b
+            },
+            CellBox { sz: 1, ..b },
+        )
+    }
+
+    /// The disjoint boxes the piece fills.
+    pub fn boxes(&self) -> &[CellBox] {
+        &self.boxes[..self.n as usize]
+    }
+
+    /// Whether the piece fills its whole bounding box.
+    pub fn is_box(&self) -> bool {
+        self.n == 1 && self.boxes[0] == self.bbox
+    }
+
+    /// Every cell the piece fills.
+    pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
+        self.boxes().iter().flat_map(|b| b.cells())
+    }
+
+    /// Number of cells filled.
+    pub fn volume(&self) -> i32 {
+        self.boxes().iter().map(CellBox::volume).sum()
+    }
+
+    /// Whether the piece fills `c`.
+    pub fn contains(&self, c: Cell) -> bool {
+        self.boxes().iter().any(|b| b.contains(c))
+    }
+
+    /// A filled cell every placement of the same part and turn has at the
+    /// same place relative to its origin: the first cell of the bottom box.
+    pub fn key(&self) -> Cell {
+        self.boxes[0].min
+    }
+
+    /// The cells just above the studs: where a piece pressed on top sits.
+    pub fn over_studs(&self) -> CellBox {
+        self.studs.layer_above()
+    }
+
+    /// The cells just below the tubes: where a piece it is pressed onto sits.
+    pub fn under_tubes(&self) -> CellBox {
+        self.tubes.layer_below()
+    }
+
+    /// Whether `upper` is pressed onto this piece's studs.
+    pub fn holds(&self, upper: &Body) -> bool {
+        self.over_studs().intersects(&upper.tubes)
+    }
+
+    /// The body moved by `(dx, dy, dz)`.
+    pub fn moved(&self, dx: i32, dy: i32, dz: i32) -> Body {
+        let mut b = *self;
+        for x in b.boxes.iter_mut() {
+            *x = x.moved(dx, dy, dz);
+        }
+        b.bbox = b.bbox.moved(dx, dy, dz);
+        b.studs = b.studs.moved(dx, dy, dz);
+        b.tubes = b.tubes.moved(dx, dy, dz);
+        b
+    }
+
+    /// The body turned by `rot` about the vertical axis through the origin.
+    pub fn turned(&self, rot: Rot) -> Body {
+        let mut b = *self;
+        for x in b.boxes.iter_mut() {
+            *x = x.turned(rot);
+        }
+        b.bbox = b.bbox.turned(rot);
+        b.studs = b.studs.turned(rot);
+        b.tubes = b.tubes.turned(rot);
+        b
+    }
+}

@@ -102,6 +102,12 @@ struct BuildArgs {
     /// A rule file (see rules/default.rules); default: the built-in default rules.
     #[arg(long)]
     rules: Option<PathBuf>,
+    /// Use slopes too, where the surface slants (voxels become half a brick high).
+    #[arg(long)]
+    slopes: bool,
+    /// Use plates too, to follow the shape more closely (voxels become a plate high).
+    #[arg(long)]
+    plates: bool,
     /// Put this many pieces in each step (default: one piece a step, or as few as keep a
     /// big model within the 255 steps LeoCAD can show).
     #[arg(long, conflicts_with = "step_by", value_parser = clap::value_parser!(u32).range(1..))]
@@ -155,6 +161,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
         UpAxis::Z => Up::Z,
     };
     opts.rules = a.rules;
+    opts.slopes = a.slopes;
+    opts.plates = a.plates;
     opts.steps = match (a.step_size, a.step_by) {
         (Some(n), _) => StepGrouping::Size(n as usize),
         (None, Some(StepBy::Layer)) => StepGrouping::Layer,

@@ -14,9 +14,9 @@ use thiserror::Error;
 
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, StepGrouping};
-use crate::catalog::Color;
+use crate::catalog::{Color, Family};
 use crate::fsutil::write_atomic;
-use crate::grammar::{default_rules_text, RuleError, RuleSet, PLATES_PER_LAYER};
+use crate::grammar::{default_rules_text, RuleError, RuleSet};
 use crate::ldraw::{write_ldr, LdrMeta};
 use crate::mesh::{self, MeshError};
 use crate::search::{self, Repairs, SearchError, SearchOptions, SearchStats};
@@ -37,6 +37,10 @@ pub struct BuildOptions {
     pub up: Up,
     /// A rule file; `None` for the built-in default rules.
     pub rules: Option<PathBuf>,
+    /// Build with slopes too (layers half a brick high). Default off.
+    pub slopes: bool,
+    /// Build with plates too (layers a plate high). Default off.
+    pub plates: bool,
     /// Step grouping in the outputs. Default one piece a step, grouped
     /// further past 255 steps.
     pub steps: StepGrouping,
@@ -53,6 +57,8 @@ impl BuildOptions {
             sizing: Sizing::default(),
             up: Up::default(),
             rules: None,
+            slopes: false,
+            plates: false,
             steps: StepGrouping::Auto,
             search: SearchOptions::default(),
         }
@@ -234,7 +240,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     // Rules first: a bad rule file should fail before any slow work.
     let t = Instant::now();
-    let rules = load_rules(opts.rules.as_deref())?;
+    let rules = load_rules(opts.rules.as_deref())?.restricted(|p| match p.spec().family() {
+        Family::Brick => true,
+        Family::Plate => opts.plates,
+        Family::Slope => opts.slopes,
+    })?;
     times.rules = secs(t);
 
     progress.stage("loading mesh");
@@ -247,7 +257,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let t = Instant::now();
     let vopts = VoxelizeOptions::default()
         .with_sizing(opts.sizing)
-        .with_up(opts.up);
+        .with_up(opts.up)
+        .with_layer_ldu(rules.layer_ldu());
     let model = voxelize(&mesh, &vopts).map_err(|reason| BuildError::Voxelize {
         file: file.clone(),
         reason,
@@ -268,10 +279,12 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     progress.stage("verifying");
     let t = Instant::now();
     let order = search::placements(&outcome);
-    let mut assembly = Assembly::from_order(&order, PLATES_PER_LAYER, Color::RED);
+    let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
     let palette = [Color::RED, Color(15)];
     for p in &mut assembly.pieces {
-        p.color = palette[(p.placement.origin.z as usize) % palette.len()];
+        // Alternate colours by brick course, so the structure reads.
+        let course = p.placement.origin.z * rules.layer_ldu() / 24;
+        p.color = palette[course as usize % palette.len()];
     }
     let check = verify(&assembly, Some(&outcome.voxels));
     if !check.is_ok() {
@@ -427,5 +440,10 @@ fn describe(opts: &BuildOptions) -> String {
         StepGrouping::Size(n) => format!(" --step-size {n}"),
         StepGrouping::Layer => " --step-by layer".into(),
     };
-    format!("{size} --up {up} --seed {}{rules}{steps}", opts.search.seed)
+    let slopes = if opts.slopes { " --slopes" } else { "" };
+    let plates = if opts.plates { " --plates" } else { "" };
+    format!(
+        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}",
+        opts.search.seed
+    )
 }

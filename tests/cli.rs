@@ -507,7 +507,7 @@ fn the_shipped_rule_files_load() {
 }
 
 /// A two-brick build with a separately built submodel (a 1x2 on a 1x2,
-/// attached to the base) and a plate the catalog does not know.
+/// attached to the base) and a tile the catalog does not know.
 const LEARN_MPD: &str = "\
 0 FILE main.ldr
 1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat
@@ -515,7 +515,7 @@ const LEARN_MPD: &str = "\
 1 4 60 -48 20 1 0 0 0 1 0 0 0 1 3001.dat
 0 STEP
 1 4 0 -48 0 1 0 0 0 1 0 0 0 1 post.ldr
-1 15 40 -80 20 1 0 0 0 1 0 0 0 1 3020.dat
+1 15 40 -80 20 1 0 0 0 1 0 0 0 1 87079.dat
 0 STEP
 0 NOFILE
 0 FILE post.ldr
@@ -540,7 +540,7 @@ fn learned_rules_drive_a_build() {
     run.assert_ok();
     for want in [
         "read 2 builds (1 separately built submodel)",
-        "1 x 3020",
+        "1 x 87079",
         "post.mpd:7",
         "distinct rules",
         "2,484",
@@ -612,8 +612,8 @@ fn learn_rejects_bad_builds_with_one_line() {
             "empty.ldr: nothing to learn from",
         ),
         (
-            "plates.ldr",
-            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3020.dat\n".to_string(),
+            "tiles.ldr",
+            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n".to_string(),
             "empty.ldr: nothing to learn from",
         ),
     ];

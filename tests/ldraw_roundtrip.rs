@@ -46,7 +46,10 @@ fn every_part_in_every_rotation_round_trips() {
                 Placement::new(kind, Cell::new(3, 5, 2), rot),
                 Placement::new(kind, Cell::new(1, 0, 7), rot.then(Rot::R90)),
             ];
-            let asm = Assembly::from_order(&order, 3, Color(71));
+            // Layers as high as to_assembly picks them: a brick, or a
+            // plate for plates.
+            let layer_ldu = kind.spec().height_ldu();
+            let asm = Assembly::from_order(&order, layer_ldu, Color(71));
             assert_eq!(round_trip(&asm), asm, "{kind} {rot:?}");
         }
     }
@@ -65,7 +68,7 @@ fn reader_shifts_the_lowest_corner_to_zero_and_keeps_steps_and_colours() {
             p("3010", -2, 9, 4, Rot::R90, 1, 15),
             p("3003", 0, 12, 5, Rot::R0, 2, 1),
         ],
-        plates_per_layer: 3,
+        layer_ldu: 24,
     };
     let back = round_trip(&asm);
     let shifted: Vec<Placed> = asm
@@ -95,7 +98,7 @@ fn golden_assembly() -> Assembly {
             p("3010", 1, 1, 1, Rot::R0, 2, 15),
             p("3003", 4, 2, 1, Rot::R0, 2, 1),
         ],
-        plates_per_layer: 3,
+        layer_ldu: 24,
     }
 }
 
@@ -235,7 +238,7 @@ fn mpd_file_reads_into_one_assembly() {
         Placement::new(part("3001"), Cell::new(0, 0, 0), Rot::R0),
         Placement::new(part("3001"), Cell::new(0, 0, 1), Rot::R0),
     ];
-    let mut want = Assembly::from_order(&order, 3, Color(4));
+    let mut want = Assembly::from_order(&order, 24, Color(4));
     want.pieces[1].color = Color(15);
     assert_eq!(asm, want);
 }

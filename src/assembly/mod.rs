@@ -9,7 +9,7 @@ pub mod verify;
 use serde::Serialize;
 
 use crate::catalog::{Color, PartKind};
-use crate::geom::{Cell, CellBox, Rot};
+use crate::geom::{Body, Cell, Rot};
 
 /// A building step number, counted from 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -36,16 +36,10 @@ impl Placement {
         }
     }
 
-    /// The cells the piece fills, given the grid's plates per layer.
-    pub fn cells_box(&self, plates_per_layer: u8) -> CellBox {
-        let spec = self.part.spec();
-        let (sx, sy) = spec.footprint(self.rot);
-        CellBox {
-            min: self.origin,
-            sx,
-            sy,
-            sz: (spec.height_plates / plates_per_layer).max(1) as i32,
-        }
+    /// The cells the piece fills and where it connects, in a grid of
+    /// `layer_ldu`-high layers.
+    pub fn body(&self, layer_ldu: i32) -> Body {
+        self.part.body(self.rot, self.origin, layer_ldu)
     }
 }
 
@@ -65,13 +59,14 @@ pub struct Placed {
 pub struct Assembly {
     /// Pieces in build order; steps never decrease.
     pub pieces: Vec<Placed>,
-    /// Plates per voxel layer (3 for bricks).
-    pub plates_per_layer: u8,
+    /// Height of a voxel layer in LDU: 24 for bricks, 12 with slopes, 8
+    /// with plates.
+    pub layer_ldu: i32,
 }
 
 impl Assembly {
     /// An assembly from placements in build order, one step each.
-    pub fn from_order(order: &[Placement], plates_per_layer: u8, color: Color) -> Self {
+    pub fn from_order(order: &[Placement], layer_ldu: i32, color: Color) -> Self {
         Assembly {
             pieces: order
                 .iter()
@@ -82,7 +77,7 @@ impl Assembly {
                     color,
                 })
                 .collect(),
-            plates_per_layer,
+            layer_ldu,
         }
     }
 
@@ -155,7 +150,7 @@ mod tests {
         let order: Vec<Placement> = (0..n)
             .map(|i| Placement::new(part, Cell::new(0, 0, i as i32 / 3), Rot::R0))
             .collect();
-        Assembly::from_order(&order, 3, Color::RED)
+        Assembly::from_order(&order, 24, Color::RED)
     }
 
     #[test]

@@ -8,17 +8,21 @@
 //!
 //! # The rules
 //!
-//! A piece fills the cells of [`Placement::cells_box`]. For the pieces in
-//! build order (`asm.pieces`):
+//! A piece fills the cells of its [`Placement::body`] and takes up the space
+//! of the body's bounding box (a slope's sloping face passes through the
+//! cells of its box it does not fill). For the pieces in build order
+//! (`asm.pieces`):
 //!
-//! - **No overlap**: no two pieces share a cell ([`Failure::Overlap`]).
-//! - **Stud connection**: piece A is connected to piece B when A sits
-//!   directly below B (`A.min.z + A.sz == B.min.z`) and their footprints
-//!   overlap, or the reverse. Every piece after the first must be connected to
+//! - **No overlap**: no two pieces' bounding boxes share a cell
+//!   ([`Failure::Overlap`]).
+//! - **Stud connection**: piece A is connected to piece B when B's bottom
+//!   rests on A's top and some of A's studs (a slope has studs on its back
+//!   row only) meet B's underside where it takes studs (an inverted slope
+//!   only under its back row), or the reverse. Every piece after the first must be connected to
 //!   at least one *earlier* piece ([`Failure::NotConnected`]), and the whole
 //!   connection graph must be one component ([`Failure::Disconnected`]).
-//! - **Cover**: given a target voxel grid, the union of the pieces' cells
-//!   equals its filled cells exactly ([`Failure::CoverMismatch`]).
+//! - **Cover**: given a target voxel grid, the union of the cells the pieces
+//!   fill equals its filled cells exactly ([`Failure::CoverMismatch`]).
 //! - **Placeable at its turn** ([`Failure::NotPlaceable`]): let `O` be the
 //!   cells of all earlier pieces. The piece can be brought in from outside
 //!   iff, starting at its position, a breadth-first search over integer
@@ -46,7 +50,7 @@
 //!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
 //!     Placement::new(brick, Cell::new(2, 0, 1), Rot::R0),
 //! ];
-//! let report = verify(&Assembly::from_order(&order, 3, Color::RED), None);
+//! let report = verify(&Assembly::from_order(&order, 24, Color::RED), None);
 //! assert!(report.is_ok(), "{report}");
 //! ```
 
@@ -54,7 +58,7 @@ use std::collections::{HashMap, HashSet, VecDeque};
 use std::fmt;
 
 use crate::assembly::{Assembly, Step};
-use crate::geom::{Cell, CellBox};
+use crate::geom::{Body, Cell, CellBox};
 use crate::voxel::VoxelGrid;
 
 #[cfg(doc)]
@@ -168,11 +172,12 @@ impl fmt::Display for VerifyReport {
 /// Checks `asm` against every rule of the module docs, and its cover against
 /// `target` when given.
 pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
-    let boxes: Vec<CellBox> = asm
+    let bodies: Vec<Body> = asm
         .pieces
         .iter()
-        .map(|p| p.placement.cells_box(asm.plates_per_layer))
+        .map(|p| p.placement.body(asm.layer_ldu))
         .collect();
+    let boxes: Vec<CellBox> = bodies.iter().map(|b| b.bbox).collect();
     let steps: Vec<Step> = asm.pieces.iter().map(|p| p.step).collect();
     let mut failures = check_overlaps(&boxes);
     let overlapping: HashSet<usize> = failures
@@ -183,7 +188,7 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
         })
         .collect();
 
-    let neighbours = connections(&boxes);
+    let neighbours = connections(&bodies);
     let mut occupied = Occupied::default();
     for (i, b) in boxes.iter().enumerate() {
         if i > 0 && !neighbours[i].iter().any(|&j| j < i) {
@@ -206,7 +211,7 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
         failures.push(Failure::Disconnected { components });
     }
     if let Some(target) = target {
-        failures.extend(check_cover(&boxes, target));
+        failures.extend(check_cover(&bodies, target));
     }
     VerifyReport { failures }
 }
@@ -231,18 +236,18 @@ fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
     failures
 }
 
-/// For each piece, the pieces it is stud-connected to (directly above or
-/// below it with overlapping footprints).
-fn connections(boxes: &[CellBox]) -> Vec<Vec<usize>> {
+/// For each piece, the pieces it is stud-connected to (resting on its studs
+/// or holding it on theirs).
+fn connections(bodies: &[Body]) -> Vec<Vec<usize>> {
     let mut by_bottom: HashMap<i32, Vec<usize>> = HashMap::new();
-    for (i, b) in boxes.iter().enumerate() {
-        by_bottom.entry(b.min.z).or_default().push(i);
+    for (i, b) in bodies.iter().enumerate() {
+        by_bottom.entry(b.tubes.min.z).or_default().push(i);
     }
-    let mut neighbours = vec![Vec::new(); boxes.len()];
-    for (below, a) in boxes.iter().enumerate() {
-        let top = a.min.z + a.sz;
+    let mut neighbours = vec![Vec::new(); bodies.len()];
+    for (below, a) in bodies.iter().enumerate() {
+        let top = a.studs.min.z + 1;
         for &above in by_bottom.get(&top).into_iter().flatten() {
-            if a.footprints_overlap(&boxes[above]) {
+            if a.holds(&bodies[above]) {
                 neighbours[below].push(above);
                 neighbours[above].push(below);
             }
@@ -275,8 +280,8 @@ fn count_components(neighbours: &[Vec<usize>]) -> usize {
 }
 
 /// The cover check: union of piece cells against the target's cells.
-fn check_cover(boxes: &[CellBox], target: &VoxelGrid) -> Option<Failure> {
-    let filled: HashSet<Cell> = boxes.iter().flat_map(|b| b.cells()).collect();
+fn check_cover(bodies: &[Body], target: &VoxelGrid) -> Option<Failure> {
+    let filled: HashSet<Cell> = bodies.iter().flat_map(|b| b.cells()).collect();
     let missing: Vec<Cell> = target.cells().filter(|c| !filled.contains(c)).collect();
     let extra: Vec<Cell> = filled.iter().copied().filter(|&c| !target.get(c)).collect();
     let first = missing
@@ -425,7 +430,7 @@ mod tests {
                 Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, y, z), r)
             })
             .collect();
-        Assembly::from_order(&order, 3, Color::RED)
+        Assembly::from_order(&order, 24, Color::RED)
     }
 
     use Rot::{R0, R90};

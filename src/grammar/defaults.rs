@@ -19,15 +19,24 @@
 use std::collections::HashSet;
 
 use super::{Dir, Rule, RuleSet, StartRule};
-use crate::catalog::PartKind;
+use crate::catalog::{Family, PartKind};
 use crate::geom::Rot;
 
-/// The alphabet of the default rule set: the paper's six bricks and the 2x3.
-pub const DEFAULT_ALPHABET: [&str; 7] = ["3005", "3004", "3622", "3010", "3003", "3002", "3001"];
+/// The alphabet of the default rule set: the paper's six bricks and the
+/// 2x3, the six plates the issue names, and the slopes (used with
+/// `--plates` and `--slopes`).
+pub const DEFAULT_ALPHABET: [&str; 21] = [
+    "3005", "3004", "3622", "3010", "3003", "3002", "3001", // bricks
+    "3024", "3023b", "3623", "3710", "3022", "3020", // plates
+    "3040b", "3039", "3038", "3037", "4286", "3298", "3665a", "3660a", // slopes
+];
 
 /// Every brick in the catalog, for `--rules rules/extended.rules`.
 pub fn extended_alphabet() -> Vec<&'static str> {
-    PartKind::all().map(|k| k.spec().id.0).collect()
+    PartKind::all()
+        .filter(|k| k.spec().family() == Family::Brick)
+        .map(|k| k.spec().id.0)
+        .collect()
 }
 
 fn joint_factor(a: (i32, i32), b_at: (i32, i32), b: (i32, i32)) -> f64 {
@@ -71,12 +80,10 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
     let mut seen: HashSet<VariantKey> = HashSet::new();
     for &a in &parts {
         for &b in &parts {
-            let rots: &[Rot] = if b.spec().studs_x == b.spec().studs_y {
-                &[Rot::R0]
-            } else {
-                &[Rot::R0, Rot::R90]
-            };
-            for &rot in rots {
+            let rots = Rot::ALL
+                .into_iter()
+                .filter(|&r| b.spec().canonical_rot(r) == r);
+            for rot in rots {
                 for dir in [Dir::Up, Dir::Down] {
                     let (ax, ay) = a.spec().footprint(Rot::R0);
                     let (bx, by) = b.spec().footprint(rot);
@@ -92,13 +99,16 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
                                 weight: 1.0,
                                 line: 0,
                             };
-                            let one = RuleSet::new(
+                            // Slopes connect on part of their top or bottom
+                            // only: skip offsets where no stud meets.
+                            let Ok(one) = RuleSet::new(
                                 parts.clone(),
                                 vec![],
                                 vec![rule.clone()],
                                 String::new(),
-                            )
-                            .expect("generated rules connect");
+                            ) else {
+                                continue;
+                            };
                             let keys: Vec<_> = one
                                 .variants()
                                 .iter()
@@ -177,7 +187,7 @@ mod tests {
             "regenerate with `brickwright rules -o rules/default.rules`"
         );
         let rs = RuleSet::parse(shipped, Path::new("rules/default.rules")).unwrap();
-        assert_eq!(rs.alphabet().len(), 7);
+        assert_eq!(rs.alphabet().len(), DEFAULT_ALPHABET.len());
     }
 
     #[test]

@@ -18,8 +18,18 @@
 //! outside that instance (the model it is attached to, or a submodel nested
 //! in it) do not. Colours do not matter. Parts outside the catalog are
 //! skipped and reported, with a count and the first place each was met;
-//! a piece off the stud or plate grid, or tilted, is an error naming its
-//! `file:line`.
+//! a piece off the stud grid or the half-plate (4 LDU) grid, or tilted, is
+//! an error naming its `file:line`.
+//!
+//! Pieces are bodies (see [`crate::geom::Body`]): `B` stud-connects to `A`
+//! when `B`'s tubes press onto `A`'s studs or the other way round, so a
+//! brick on a slope's back row counts and a brick on its stud-less front
+//! row does not. Every piece of a learning run is mapped onto one grid, its
+//! layers as high as all the builds allow (as [`crate::ldraw::to_assembly`]
+//! chooses them: 24 LDU for bricks on brick courses, 8 once plates appear,
+//! 12 or 4 for bricks half a brick apart). A rule's geometry (`dx`, `dy` in
+//! studs, `dir`, `B`'s rotation) does not depend on that height, so one
+//! learned file serves every layer height.
 //!
 //! A rule is counted once however the observed pair was turned: see
 //! [`RuleKey`]. The result, [`Learned`], writes a rule file that
@@ -53,15 +63,11 @@ use std::path::PathBuf;
 use serde::Serialize;
 use thiserror::Error;
 
-use super::{turn_box, Dir, Rule, RuleError, RuleSet, StartRule};
+use super::{Dir, Rule, RuleError, RuleSet, StartRule};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::Rot;
-use crate::ldraw::{read_ldr, to_placement, LdrError, LdrModel};
-
-/// Plates per grid layer while learning: 1, so a layer is one plate and a
-/// brick may stand at any plate height (on the 8 LDU plate grid).
-const GRID_PLATES: u8 = 1;
+use crate::geom::{Body, Rot};
+use crate::ldraw::{layer_ldu_of, read_ldr, to_placement, LdrError, LdrModel};
 
 /// The paper's figures for its collected data (section 5), shown beside
 /// ours in [`Learned::summary`]: distinct rules, total count, lowest and
@@ -75,7 +81,7 @@ const NAMES_IN_ERRORS: usize = 5;
 #[derive(Debug, Error)]
 pub enum LearnError {
     /// A build could not be read, or has a bad line: a line that is not
-    /// LDraw, a piece off the stud or plate grid, a tilted piece.
+    /// LDraw, a piece off the stud or half-plate grid, a tilted piece.
     #[error(transparent)]
     Ldraw(#[from] LdrError),
     /// A directory given as a build could not be listed.
@@ -176,6 +182,9 @@ pub struct LearnReport {
     pub skipped: Vec<Skipped>,
     /// The catalog parts seen, in catalog order.
     pub parts: Vec<PartKind>,
+    /// The height in LDU of the grid layers all pieces were mapped onto:
+    /// the largest the builds allow (24, 12, 8 or 4).
+    pub layer_ldu: i32,
 }
 
 /// Rule counts learned from builds, and how they were read.
@@ -239,10 +248,18 @@ fn build_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LearnError> {
     Ok(files)
 }
 
-/// Counts rules build by build; [`learn`] drives it over files.
+/// Reads builds and counts the rules they use; [`learn`] drives it over
+/// files.
+///
+/// [`Learner::add`] reads a build's pieces and checks them;
+/// [`Learner::finish`] counts the joints, once the layer height all the
+/// builds allow is known.
 #[derive(Debug, Default)]
 pub struct Learner {
-    counts: BTreeMap<RuleKey, u64>,
+    /// Each build's catalog pieces in build order, with the submodel
+    /// instance each belongs to; `z` is the piece's bottom in LDU above the
+    /// build's lowest piece.
+    builds: Vec<Vec<(usize, Placement)>>,
     report: LearnReport,
     skipped: BTreeMap<String, Skipped>,
 }
@@ -253,46 +270,28 @@ impl Learner {
         Learner::default()
     }
 
-    /// Counts the rules one build uses.
+    /// Reads one build.
     ///
-    /// Errors, counting nothing, if a catalog piece is off the grid or
+    /// Errors, taking nothing in, if a catalog piece is off the grid or
     /// tilted, or if the build has no catalog piece at all.
     pub fn add(&mut self, model: &LdrModel) -> Result<(), LearnError> {
         let mut placed: Vec<(usize, Placement)> = Vec::new();
-        let mut counts: Vec<RuleKey> = Vec::new();
-        let (mut starts, mut attachments) = (0, 0);
         let mut skipped: Vec<(String, usize)> = Vec::new();
         for r in &model.parts {
             if PartKind::from_id(&r.part).is_none() {
                 skipped.push((part_name(&r.part), r.line));
                 continue;
             }
-            let piece = to_placement(r, &model.path, GRID_PLATES)?;
-            let mut joined = false;
-            for (instance, earlier) in &placed {
-                let Some(dir) = link(earlier, &piece) else {
-                    continue;
-                };
-                if *instance == r.instance {
-                    counts.push(rule_key(earlier, &piece, dir));
-                    joined = true;
-                } else {
-                    attachments += 1;
-                }
-            }
-            if !joined {
-                starts += 1;
-            }
-            placed.push((r.instance, piece));
+            placed.push((r.instance, to_placement(r, &model.path)?));
         }
-        if placed.is_empty() {
+        let Some(low) = placed.iter().map(|(_, p)| p.origin.z).min() else {
             return Err(LearnError::NothingToLearn {
                 path: model.path.clone(),
                 why: nothing_to_learn(&skipped),
             });
-        }
-        for key in counts {
-            *self.counts.entry(key).or_insert(0) += 1;
+        };
+        for (_, p) in &mut placed {
+            p.origin.z -= low;
         }
         for (part, line) in skipped {
             self.skipped
@@ -312,32 +311,72 @@ impl Learner {
         r.submodel_builds += model.instances.len() - 1;
         r.pieces += model.parts.len();
         r.learned_pieces += placed.len();
-        r.starts += starts;
-        r.attachments += attachments;
-        for (_, p) in placed {
+        for (_, p) in &placed {
             if let Err(at) = r.parts.binary_search(&p.part) {
                 r.parts.insert(at, p.part);
             }
         }
+        self.builds.push(placed);
         Ok(())
     }
 
-    /// The counts so far, with the rule set they make.
+    /// Counts the rules the builds use, on one grid for all of them, and
+    /// makes the rule set.
     pub fn finish(self) -> Result<Learned, LearnError> {
         let mut report = self.report;
-        if report.builds.is_empty() {
+        if self.builds.is_empty() {
             return Err(LearnError::NoBuilds);
+        }
+        report.layer_ldu = layer_ldu_of(self.builds.iter().flatten().map(|(_, p)| p));
+        let mut counts = BTreeMap::new();
+        for build in &self.builds {
+            count_build(build, report.layer_ldu, &mut counts, &mut report);
         }
         report.skipped = self.skipped.into_values().collect();
         report
             .skipped
             .sort_by(|a, b| b.count.cmp(&a.count).then_with(|| a.part.cmp(&b.part)));
-        let rules = rule_set(&report.parts, &self.counts)?;
+        let rules = rule_set(&report.parts, &counts)?;
         Ok(Learned {
-            counts: self.counts,
+            counts,
             report,
             rules,
         })
+    }
+}
+
+/// Counts the joints of one build, whose pieces' bottoms are in LDU, in a
+/// grid of `layer_ldu`-high layers (which divides every bottom): each joint
+/// inside a submodel instance into `counts`, the others, and the pieces
+/// joined to nothing earlier, into `report`.
+fn count_build(
+    pieces: &[(usize, Placement)],
+    layer_ldu: i32,
+    counts: &mut BTreeMap<RuleKey, u64>,
+    report: &mut LearnReport,
+) {
+    let mut placed: Vec<(usize, Placement, Body)> = Vec::with_capacity(pieces.len());
+    for &(instance, mut piece) in pieces {
+        debug_assert_eq!(piece.origin.z % layer_ldu, 0);
+        piece.origin.z /= layer_ldu;
+        let body = piece.body(layer_ldu);
+        let mut joined = false;
+        for (earlier_instance, earlier, earlier_body) in &placed {
+            let Some(dir) = link(earlier_body, &body) else {
+                continue;
+            };
+            if *earlier_instance == instance {
+                let key = rule_key(earlier, earlier_body, &piece, &body, dir);
+                *counts.entry(key).or_insert(0) += 1;
+                joined = true;
+            } else {
+                report.attachments += 1;
+            }
+        }
+        if !joined {
+            report.starts += 1;
+        }
+        placed.push((instance, piece, body));
     }
 }
 
@@ -398,39 +437,39 @@ fn rule_set(parts: &[PartKind], counts: &BTreeMap<RuleKey, u64>) -> Result<RuleS
 }
 
 /// Whether `b` stud-connects to `a`, and on which side of `a` it is: `Up`
-/// when `b` stands on `a`'s top, `Down` when `a` stands on `b`'s.
+/// when `b` is pressed onto `a`'s studs, `Down` when `a` is pressed onto
+/// `b`'s.
 ///
 /// All of the "what connects" geometry of learning is here (and in
-/// [`rule_key`]): for now, pieces are boxes whose footprints must overlap,
-/// one directly on top of the other, in a grid one plate a layer.
-fn link(a: &Placement, b: &Placement) -> Option<Dir> {
-    let (ab, bb) = (a.cells_box(GRID_PLATES), b.cells_box(GRID_PLATES));
-    if !ab.footprints_overlap(&bb) {
-        None
-    } else if bb.min.z == ab.min.z + ab.sz {
+/// [`rule_key`]); it is the bodies' own, as the rule set checks its rules:
+/// a piece on a slope's stud-less front row is not connected.
+fn link(a: &Body, b: &Body) -> Option<Dir> {
+    if a.holds(b) {
         Some(Dir::Up)
-    } else if bb.min.z + bb.sz == ab.min.z {
+    } else if b.holds(a) {
         Some(Dir::Down)
     } else {
         None
     }
 }
 
-/// The canonical rule that joining `b` to `a` on side `dir` uses.
+/// The canonical rule that joining `b` (body `bb`) to `a` (body `ab`) on
+/// side `dir` uses.
 ///
 /// Writes the pair with `a` unturned in each way that leaves `a` looking
-/// the same (undoing its rotation, then any turn of its symmetry) and keeps
-/// the smallest `(added_rot, dx, dy)`; so every turn of the same joint gives
-/// the same key, and distinct keys generate distinct rule variants.
-fn rule_key(a: &Placement, b: &Placement, dir: Dir) -> RuleKey {
+/// the same (undoing its rotation, then any turn of its symmetry: none but
+/// the identity for a slope) and keeps the smallest `(added_rot, dx, dy)`;
+/// so every turn of the same joint gives the same key, and distinct keys
+/// generate distinct rule variants. Offsets are between the bounding boxes'
+/// minimum corners, in studs, as in rule files.
+fn rule_key(a: &Placement, ab: &Body, b: &Placement, bb: &Body, dir: Dir) -> RuleKey {
     let (sa, sb) = (a.part.spec(), b.part.spec());
-    let (ab, bb) = (a.cells_box(GRID_PLATES), b.cells_box(GRID_PLATES));
     Rot::ALL
         .into_iter()
         .filter(|&s| sa.canonical_rot(s) == Rot::R0)
         .map(|s| {
             let undo = inverse(a.rot.then(s));
-            let (ta, tb) = (turn_box(&ab, undo), turn_box(&bb, undo));
+            let (ta, tb) = (ab.bbox.turned(undo), bb.bbox.turned(undo));
             RuleKey {
                 anchor: a.part,
                 added: b.part,
@@ -565,6 +604,11 @@ impl Learned {
              joints attaching separate submodels (not counted): {}",
             thousands(r.starts as u64),
             thousands(r.attachments)
+        );
+        let _ = writeln!(
+            s,
+            "  pieces mapped onto layers of {} LDU (the rules hold at any layer height)",
+            r.layer_ldu
         );
         let (p_rules, p_total, p_min, p_max) = PAPER_FIGURES;
         let range = match self.count_range() {

@@ -36,8 +36,8 @@ pub use parse::RuleError;
 
 use serde::Serialize;
 
-use crate::catalog::PartKind;
-use crate::geom::{Cell, CellBox, Rot};
+use crate::catalog::{Family, PartKind};
+use crate::geom::{Body, Cell, Rot};
 
 /// Which side of its anchor a rule's new piece goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -126,18 +126,17 @@ pub struct RuleSet {
     pub source: String,
 }
 
-/// Plates per layer of the voxel grids this rule set builds (bricks only).
-pub const PLATES_PER_LAYER: u8 = 3;
-
-/// The cells of `part` turned by `rot` with its minimum corner at `at`.
-pub fn piece_box(part: PartKind, rot: Rot, at: Cell) -> CellBox {
-    let spec = part.spec();
-    let (sx, sy) = spec.footprint(rot);
-    CellBox {
-        min: at,
-        sx,
-        sy,
-        sz: (spec.height_plates / PLATES_PER_LAYER).max(1) as i32,
+/// The height, in LDU, of one voxel layer for an alphabet: a brick (24)
+/// for bricks alone, half a brick (12) once slopes are in, a plate (8) once
+/// plates are in.
+pub fn layer_ldu_for(alphabet: &[PartKind]) -> i32 {
+    let has = |f: Family| alphabet.iter().any(|p| p.spec().family() == f);
+    if has(Family::Plate) {
+        8
+    } else if has(Family::Slope) {
+        12
+    } else {
+        24
     }
 }
 
@@ -163,6 +162,34 @@ impl RuleSet {
         Ok(set)
     }
 
+    /// The same system with Σ cut down to the parts `keep` accepts: their
+    /// starting rules and the rules between them. Errors if no part or no
+    /// starting rule is left.
+    pub fn restricted(&self, keep: impl Fn(PartKind) -> bool) -> Result<RuleSet, RuleError> {
+        let alphabet: Vec<PartKind> = self.alphabet.iter().copied().filter(|&p| keep(p)).collect();
+        let starts: Vec<StartRule> = self
+            .starts
+            .iter()
+            .filter(|s| keep(s.part))
+            .cloned()
+            .collect();
+        if starts.is_empty() {
+            return Err(RuleError::File {
+                file: self.source.clone(),
+                message:
+                    "no starting rule is left for the parts asked for (see --slopes and --plates)"
+                        .into(),
+            });
+        }
+        let rules = self
+            .rules
+            .iter()
+            .filter(|r| keep(r.anchor) && keep(r.added))
+            .cloned()
+            .collect();
+        RuleSet::new(alphabet, starts, rules, self.source.clone())
+    }
+
     /// The letters of Σ.
     pub fn alphabet(&self) -> &[PartKind] {
         &self.alphabet
@@ -176,6 +203,18 @@ impl RuleSet {
     /// The basic-form rules, as written.
     pub fn rules(&self) -> &[Rule] {
         &self.rules
+    }
+
+    /// The height in LDU of one layer of the voxel grids this rule set
+    /// builds (see [`layer_ldu_for`]).
+    pub fn layer_ldu(&self) -> i32 {
+        layer_ldu_for(&self.alphabet)
+    }
+
+    /// The cells `part` fills turned by `rot` with its minimum corner at
+    /// `at`, in this rule set's layers.
+    pub fn body(&self, part: PartKind, rot: Rot, at: Cell) -> Body {
+        part.body(rot, at, self.layer_ldu())
     }
 
     /// Every rotation of every basic rule.
@@ -200,26 +239,38 @@ impl RuleSet {
                     ));
                 }
             }
-            let a = piece_box(r.anchor, Rot::R0, Cell::new(0, 0, 0));
-            let b0 = piece_box(r.added, r.added_rot, Cell::new(r.dx, r.dy, 0));
-            if !a.footprints_overlap(&b0) {
+            let a = self.body(r.anchor, Rot::R0, Cell::new(0, 0, 0));
+            let dz = match r.dir {
+                Dir::Up => a.bbox.sz,
+                Dir::Down => -(r.added.spec().height_ldu() / self.layer_ldu()).max(1),
+            };
+            let b0 = self.body(r.added, r.added_rot, Cell::new(r.dx, r.dy, dz));
+            let connects = match r.dir {
+                Dir::Up => a.holds(&b0),
+                Dir::Down => b0.holds(&a),
+            };
+            if !connects {
                 return Err(RuleError::at(
                     &self.source,
                     r.line,
                     format!(
-                        "the new {} at offset ({}, {}) does not overlap the {} below or above it, so no stud connects them",
-                        r.added, r.dx, r.dy, r.anchor
+                        "the new {} at offset ({}, {}) {} is not stud-connected to the {}",
+                        r.added,
+                        r.dx,
+                        r.dy,
+                        if r.dir == Dir::Up {
+                            "on top"
+                        } else {
+                            "underneath"
+                        },
+                        r.anchor
                     ),
                 ));
             }
             let mut mine: Vec<Variant> = Vec::new();
             for turn in Rot::ALL {
-                let ra = turn_box(&a, turn);
-                let rb = turn_box(&b0, turn);
-                let dz = match r.dir {
-                    Dir::Up => a.sz,
-                    Dir::Down => -b0.sz,
-                };
+                let ra = a.turned(turn).bbox;
+                let rb = b0.turned(turn).bbox;
                 let v = Variant {
                     rule: RuleId(i as u32),
                     anchor: r.anchor,
@@ -293,20 +344,6 @@ fn same_geometry(a: &Variant, b: &Variant) -> bool {
         && a.dir == b.dir
 }
 
-/// Turns a box about the vertical axis through the origin (cell corners).
-fn turn_box(b: &CellBox, turn: Rot) -> CellBox {
-    let (x0, y0) = (b.min.x, b.min.y);
-    let (x1, y1) = (b.min.x + b.sx, b.min.y + b.sy);
-    let (ax, ay) = turn.apply(x0, y0);
-    let (bx, by) = turn.apply(x1, y1);
-    CellBox {
-        min: Cell::new(ax.min(bx), ay.min(by), b.min.z),
-        sx: (ax - bx).abs(),
-        sy: (ay - by).abs(),
-        sz: b.sz,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -342,13 +379,12 @@ mod tests {
     fn every_variant_connects_its_pieces() {
         let rs = RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap();
         for v in rs.variants() {
-            let a = piece_box(v.anchor, v.anchor_rot, Cell::new(0, 0, 0));
+            let a = rs.body(v.anchor, v.anchor_rot, Cell::new(0, 0, 0));
             let (dx, dy, dz) = v.offset;
-            let b = piece_box(v.added, v.added_rot, Cell::new(dx, dy, dz));
-            assert!(a.footprints_overlap(&b), "{v:?}");
+            let b = rs.body(v.added, v.added_rot, Cell::new(dx, dy, dz));
             match v.dir {
-                Dir::Up => assert_eq!(b.min.z, a.min.z + a.sz),
-                Dir::Down => assert_eq!(b.min.z + b.sz, a.min.z),
+                Dir::Up => assert!(a.holds(&b), "{v:?}"),
+                Dir::Down => assert!(b.holds(&a), "{v:?}"),
             }
         }
     }

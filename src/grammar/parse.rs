@@ -215,7 +215,7 @@ mod tests {
         let head = "part 3001\nstart 3001\n";
         assert_eq!(
             err(&format!("{head}rule 3001 3001 r0 up 9 0 1\n")),
-            "bad.rules:3: the new 3001 at offset (9, 0) does not overlap the 3001 below or above it, so no stud connects them"
+            "bad.rules:3: the new 3001 at offset (9, 0) on top is not stud-connected to the 3001"
         );
         assert!(err(&format!("{head}\n# c\nrule 3001 9999 r0 up 0 0 1\n"))
             .starts_with("bad.rules:5: unknown part `9999`"));

@@ -29,13 +29,16 @@
 //! footprint `(sx, sy)` and `h` plates tall, therefore sits at
 //!
 //! ```text
-//! X = 20*x0 + 10*sx,   Z = 20*y0 + 10*sy,   Y = -(8*plates_per_layer*z + 8*h)
+//! X = 20*x0 + 10*sx,   Z = 20*y0 + 10*sy,   Y = -(layer_ldu*z + 8*h)
 //! ```
 //!
 //! (for bricks in a brick grid, `Y = -24*(z + 1)`), turned by
 //! [`rot_matrix`]`(rot)`. [`Rot::R90`] takes the part's X (its long side) to
 //! LDraw +Z, grid +y, exactly as [`crate::catalog::PartSpec::footprint`]
-//! and [`Rot::apply`] say.
+//! and [`Rot::apply`] say. A slope's origin is the centre of its studded
+//! back row, not of its footprint: it sits `10*(depth - 1)` LDU from the
+//! footprint's centre toward the back (the part's own `+Z`), turned with
+//! the part.
 //!
 //! # Reading
 //!
@@ -61,7 +64,7 @@
 //!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
 //!     Placement::new(brick, Cell::new(1, 0, 1), Rot::R90),
 //! ];
-//! let asm = Assembly::from_order(&order, 3, Color::RED);
+//! let asm = Assembly::from_order(&order, 24, Color::RED);
 //! let meta = LdrMeta {
 //!     title: "Two bricks".into(),
 //!     name: "two.ldr".into(),
@@ -86,9 +89,12 @@ use std::path::PathBuf;
 use thiserror::Error;
 
 use crate::assembly::Placement;
+use crate::catalog::{PartKind, Shape};
 use crate::geom::Rot;
 
-pub use read::{parse_ldr, read_ldr, to_assembly, to_placement, Instance, LdrModel, PartRef};
+pub use read::{
+    layer_ldu_of, parse_ldr, read_ldr, to_assembly, to_placement, Instance, LdrModel, PartRef,
+};
 pub use write::{write_ldr, LdrMeta};
 
 #[cfg(doc)]
@@ -123,20 +129,35 @@ pub const fn rot_matrix(rot: Rot) -> [[i32; 3]; 3] {
 }
 
 /// The LDraw position `(X, Y, Z)` in LDU of a placement's part origin (the
-/// centre of its top face), for a grid of `plates_per_layer` plates a layer.
+/// centre of a brick's top face, of a slope's studded back row), for a grid
+/// of `layer_ldu`-high layers.
 ///
 /// The part's bottom rests on the floor of its origin layer:
-/// `Y = -(8 * plates_per_layer * z + 8 * height_plates)`.
-pub fn placement_position(p: &Placement, plates_per_layer: u8) -> [i64; 3] {
+/// `Y = -(layer_ldu * z + 8 * height_plates)`.
+pub fn placement_position(p: &Placement, layer_ldu: i32) -> [i64; 3] {
     let spec = p.part.spec();
     let (sx, sy) = spec.footprint(p.rot);
     let stud = i64::from(LDU_PER_STUD);
     let plate = i64::from(LDU_PER_PLATE);
-    let x = stud * i64::from(p.origin.x) + stud / 2 * i64::from(sx);
-    let z = stud * i64::from(p.origin.y) + stud / 2 * i64::from(sy);
-    let bottom = plate * i64::from(plates_per_layer) * i64::from(p.origin.z);
+    let (bx, by) = origin_offset(p.part, p.rot);
+    let x = stud * i64::from(p.origin.x) + stud / 2 * i64::from(sx) + bx;
+    let z = stud * i64::from(p.origin.y) + stud / 2 * i64::from(sy) + by;
+    let bottom = i64::from(layer_ldu) * i64::from(p.origin.z);
     let y = -(bottom + plate * i64::from(spec.height_plates));
     [x, y, z]
+}
+
+/// Where a part's LDraw origin lies from the centre of its footprint, in
+/// LDU along LDraw `(X, Z)`: nowhere for bricks and plates, toward the back
+/// row for slopes.
+pub(crate) fn origin_offset(part: PartKind, rot: Rot) -> (i64, i64) {
+    let spec = part.spec();
+    if spec.shape == Shape::Rect {
+        return (0, 0);
+    }
+    let d = i64::from(LDU_PER_STUD) / 2 * (i64::from(spec.studs_y) - 1);
+    let (bx, by) = spec.back(rot);
+    (d * i64::from(bx), d * i64::from(by))
 }
 
 /// Everything that can go wrong reading an LDraw file.
@@ -324,6 +345,13 @@ mod tests {
         for part in PartKind::all() {
             let s = part.spec();
             let (hx, hz) = (10 * s.studs_x as i32, 10 * s.studs_y as i32);
+            // A slope's origin is on its back row: its body runs from
+            // +10 to the front at -(20*depth - 10) (measured from 3039.dat).
+            let (zlo, zhi) = if s.shape == Shape::Rect {
+                (-hz, hz)
+            } else {
+                (10 - 2 * hz, 10)
+            };
             let h = 8 * s.height_plates as i32;
             for r in Rot::ALL {
                 let p = Placement {
@@ -331,11 +359,11 @@ mod tests {
                     origin: Cell::new(3, -2, 5),
                     rot: r,
                 };
-                let pos = placement_position(&p, 3).map(|v| v as i32);
+                let pos = placement_position(&p, 8).map(|v| v as i32);
                 let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
                 for cx in [-hx, hx] {
                     for cy in [0, h] {
-                        for cz in [-hz, hz] {
+                        for cz in [zlo, zhi] {
                             let w = mul(rot_matrix(r), [cx, cy, cz]);
                             for a in 0..3 {
                                 lo[a] = lo[a].min(w[a] + pos[a]);
@@ -344,11 +372,11 @@ mod tests {
                         }
                     }
                 }
-                let b = p.cells_box(3);
+                let b = p.body(8).bbox;
                 let m = b.max_excl();
                 assert_eq!([lo[0], hi[0]], [20 * b.min.x, 20 * m.x], "{part} {r:?} X");
                 assert_eq!([lo[2], hi[2]], [20 * b.min.y, 20 * m.y], "{part} {r:?} Z");
-                assert_eq!([-hi[1], -lo[1]], [24 * b.min.z, 24 * m.z], "{part} {r:?} Y");
+                assert_eq!([-hi[1], -lo[1]], [8 * b.min.z, 8 * m.z], "{part} {r:?} Y");
             }
         }
     }
@@ -362,7 +390,7 @@ mod tests {
             origin: Cell::new(0, 0, 0),
             rot: Rot::R90,
         };
-        let pos = placement_position(&p, 3);
+        let pos = placement_position(&p, 24);
         assert_eq!(pos, [20, -24, 40]);
         let w = mul(rot_matrix(Rot::R90), [40, 0, -20]);
         assert_eq!([w[0] / 20, w[2] / 20], [1, 2]);

@@ -14,9 +14,9 @@
 //! 2. [`to_assembly`] maps each reference to a catalog part, a quarter-turn
 //!    [`Rot`] and a grid cell, the inverse of [`super::write_ldr`], and
 //!    rejects what does not fit: unknown parts, tilted parts, positions off
-//!    the stud grid. [`to_placement`] does the same for one reference, in a
-//!    grid of any number of plates a layer and without the shift
-//!    (`brickwright learn` uses it one plate a layer).
+//!    the stud grid. [`to_placement`] does the same for one reference,
+//!    without the shift and with the piece's bottom in LDU (`brickwright
+//!    learn` maps its builds with it).
 //!
 //! Every error names `file:line`; garbage input gives an error, never a
 //! panic.
@@ -28,7 +28,7 @@ use crate::assembly::{Assembly, Placed, Placement, Step};
 use crate::catalog::{Color, PartKind};
 use crate::geom::{Cell, Rot};
 
-use super::{rot_matrix, LdrError, LDU_PER_PLATE, LDU_PER_STUD};
+use super::{origin_offset, rot_matrix, LdrError, LDU_PER_PLATE, LDU_PER_STUD};
 
 /// Most references (parts and submodels) one file may expand to.
 const MAX_EXPANDED: usize = 1_000_000;
@@ -46,8 +46,8 @@ const MATRIX_TOLERANCE: f64 = 1e-3;
 /// The colour code meaning "the colour of the referencing line".
 const INHERIT_COLOUR: Color = Color(16);
 
-/// Plates per voxel layer of the assemblies [`to_assembly`] builds (bricks).
-const BRICK_PLATES_PER_LAYER: u8 = 3;
+/// The finest vertical step, in LDU, a piece may sit at: half a plate.
+const Y_GRID_LDU: f64 = 4.0;
 
 /// One part reference of a flattened model.
 #[derive(Debug, Clone, PartialEq)]
@@ -151,15 +151,19 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
 ///
 /// The cells are translated so that the lowest x, y and z over all pieces
 /// are 0. Steps are renumbered 1, 2, 3, ... in order, skipping steps with no
-/// pieces. The result uses 3 plates a layer (one brick a layer).
+/// pieces. The layers are as high as the pieces allow: a brick (24 LDU)
+/// for bricks on brick layers, 12 LDU with slopes or bricks offset by half
+/// a brick, 8 with plates, 4 with both.
 pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
     let mut raw = Vec::with_capacity(model.parts.len());
     for r in &model.parts {
-        raw.push((
-            to_placement(r, &model.path, BRICK_PLATES_PER_LAYER)?,
-            r.step,
-            r.color,
-        ));
+        raw.push((to_placement(r, &model.path)?, r.step, r.color));
+    }
+    let low = raw.iter().map(|(p, _, _)| p.origin.z).min().unwrap_or(0);
+    let layer_ldu = layer_ldu_of(raw.iter().map(|(p, _, _)| p));
+    for (p, _, _) in &mut raw {
+        // The reader leaves the bottom in LDU; make it a layer index.
+        p.origin.z = (p.origin.z - low) / layer_ldu;
     }
     let lo = raw
         .iter()
@@ -185,20 +189,42 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
             color,
         });
     }
-    Ok(Assembly {
-        pieces,
-        plates_per_layer: BRICK_PLATES_PER_LAYER,
+    Ok(Assembly { pieces, layer_ldu })
+}
+
+/// The height in LDU of the layers that `pieces`, as [`to_placement`] gives
+/// them (`z` the bottom in LDU), fit on: the largest that divides a brick
+/// (24 LDU), every piece's height and every bottom's height above the
+/// lowest. A brick for bricks on brick courses, 12 or 4 LDU for bricks half
+/// a brick apart, 8 once plates appear; 24 for no pieces.
+pub fn layer_ldu_of<'a>(pieces: impl Iterator<Item = &'a Placement> + Clone) -> i32 {
+    let low = pieces.clone().map(|p| p.origin.z).min().unwrap_or(0);
+    pieces.fold(24, |g, p| {
+        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
     })
 }
 
-/// One reference's catalog part, rotation and grid cell, in a grid of
-/// `plates_per_layer` plates a layer whose layer 0 stands on LDraw `Y = 0`
-/// (no shift, unlike [`to_assembly`]); `path` names the file in errors.
+fn gcd(a: i32, b: i32) -> i32 {
+    if b == 0 {
+        a.abs()
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// One reference's catalog part, rotation and raw (unshifted) grid cell,
+/// with the height of its bottom above LDraw's `Y = 0`, in LDU, as `z`
+/// (a multiple of 4: pieces stand on a half-plate grid). `path` names the
+/// file in errors.
+///
+/// [`to_assembly`] turns `z` into a layer index once it knows the layer
+/// height of the whole model; `brickwright learn` does the same over all
+/// its builds.
 ///
 /// Errors if the part is not in the catalog, is not turned by a quarter turn
-/// about the vertical axis, or does not sit on the stud grid and a layer of
-/// the grid.
-pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Placement, LdrError> {
+/// about the vertical axis, or does not sit on the stud grid and the
+/// half-plate grid.
+pub fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
     let kind = PartKind::from_id(&r.part).ok_or_else(|| LdrError::UnknownPart {
         path: path.to_path_buf(),
         line: r.line,
@@ -213,7 +239,8 @@ pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Pl
     let spec = kind.spec();
     let (sx, sy) = spec.footprint(rot);
     let stud = f64::from(LDU_PER_STUD);
-    let layer = f64::from(LDU_PER_PLATE) * f64::from(plates_per_layer);
+    let (ox, oz) = origin_offset(kind, rot);
+    let centre = [r.pos[0] - ox as f64, r.pos[2] - oz as f64];
     let height = f64::from(LDU_PER_PLATE) * f64::from(spec.height_plates);
     let off_grid = |axis: char, value: f64, why: String| LdrError::OffGrid {
         path: path.to_path_buf(),
@@ -224,7 +251,7 @@ pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Pl
         why,
     };
     let turned = format!("{} turned {}", spec.id, rot.name());
-    let x = grid_index(r.pos[0] - stud / 2.0 * f64::from(sx), stud).map_err(|far| {
+    let x = grid_index(centre[0] - stud / 2.0 * f64::from(sx), stud).map_err(|far| {
         off_grid(
             'X',
             r.pos[0],
@@ -235,7 +262,7 @@ pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Pl
             },
         )
     })?;
-    let y = grid_index(r.pos[2] - stud / 2.0 * f64::from(sy), stud).map_err(|far| {
+    let y = grid_index(centre[1] - stud / 2.0 * f64::from(sy), stud).map_err(|far| {
         off_grid(
             'Z',
             r.pos[2],
@@ -246,7 +273,7 @@ pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Pl
             },
         )
     })?;
-    let z = grid_index(-r.pos[1] - height, layer).map_err(|far| {
+    let z = grid_index(-r.pos[1] - height, Y_GRID_LDU).map_err(|far| {
         off_grid(
             'Y',
             r.pos[1],
@@ -254,18 +281,17 @@ pub fn to_placement(r: &PartRef, path: &Path, plates_per_layer: u8) -> Result<Pl
                 format!("is too far from the origin (over {MAX_ABS_LDU} LDU)")
             } else {
                 format!(
-                    "but {} must sit at Y = -({layer}*n + {height}) to stand on {}",
-                    spec.id,
-                    match plates_per_layer {
-                        BRICK_PLATES_PER_LAYER => "a brick layer",
-                        1 => "the plate grid",
-                        _ => "a layer of the grid",
-                    }
+                    "but {} must sit at Y = -(4*n + {height}) to stand on the plate grid",
+                    spec.id
                 )
             },
         )
     })?;
-    Ok(Placement::new(kind, Cell::new(x, y, z), rot))
+    Ok(Placement::new(
+        kind,
+        Cell::new(x, y, z * Y_GRID_LDU as i32),
+        rot,
+    ))
 }
 
 /// `v / unit` as an integer if `v` is within the tolerance of a multiple of

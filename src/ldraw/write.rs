@@ -40,7 +40,7 @@ pub fn write_ldr(w: &mut dyn Write, asm: &Assembly, meta: &LdrMeta) -> io::Resul
     }
     for (i, piece) in asm.pieces.iter().enumerate() {
         let p = &piece.placement;
-        let [x, y, z] = placement_position(p, asm.plates_per_layer);
+        let [x, y, z] = placement_position(p, asm.layer_ldu);
         let m = rot_matrix(p.rot);
         write!(w, "1 {} {x} {y} {z}", piece.color.0)?;
         for row in m {
@@ -90,7 +90,7 @@ mod tests {
         };
         let asm = Assembly {
             pieces: vec![piece(0, 1), piece(1, 1), piece(2, 2)],
-            plates_per_layer: 3,
+            layer_ldu: 24,
         };
         let text = write(&asm, &LdrMeta::default());
         let kinds: Vec<&str> = text.lines().map(|l| l.get(..3).unwrap_or(l)).collect();
@@ -109,7 +109,7 @@ mod tests {
             author: "me\r\n".into(),
             notes: vec!["a\nb".into()],
         };
-        let text = write(&Assembly::from_order(&[], 3, Color::RED), &meta);
+        let text = write(&Assembly::from_order(&[], 24, Color::RED), &meta);
         assert_eq!(
             text,
             "0 evil 1 4 0 0 0 1 0 0 0 1 0 0 0 1 3001.dat\n0 Name: x.ldr\n0 Author: me\n0 // a b\n"

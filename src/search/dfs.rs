@@ -16,11 +16,11 @@ use std::time::Instant;
 
 use rand_chacha::ChaCha8Rng;
 
-use super::state::{boxed, Anchor, Removal, State};
+use super::state::{Anchor, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Cell, CellBox, Rot};
+use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
 use crate::voxel::VoxelGrid;
 
@@ -66,10 +66,10 @@ struct Frame {
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     piece: Placement,
-    b: CellBox,
+    b: Body,
     committed: Option<u32>,
     anchor: Anchor,
-    anchor_box: Option<(CellBox, Option<u32>)>,
+    anchor_box: Option<(Body, Option<u32>)>,
     rule: Option<crate::grammar::RuleId>,
 }
 
@@ -206,18 +206,26 @@ impl<'a> PartSearch<'a> {
         }
     }
 
-    /// Runs the backward tracing on `v` given the structure built before.
+    /// Runs the backward tracing on `v` given the structure built before
+    /// and the whole model `solid`.
     pub fn run(
         &self,
         v: VoxelGrid,
         built: &VoxelGrid,
+        solid: &VoxelGrid,
         max_nodes: u64,
         rng: &mut ChaCha8Rng,
         stats: &mut SearchStats,
     ) -> PartResult {
         let total = v.count();
         let orders = scan_orders(&v, !built.is_empty());
-        let mut st = State::new(v, built, self.footprints.clone());
+        let mut st = State::new(
+            v,
+            built,
+            solid,
+            self.rules.layer_ldu(),
+            self.footprints.clone(),
+        );
         let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None, 0)];
         let mut nodes_here = 0u64;
         loop {
@@ -274,16 +282,13 @@ impl<'a> PartSearch<'a> {
             return None;
         }
         let bounds = st.v.bounds()?;
-        if bounds.sz != 1 {
-            return None;
-        }
         for &(part, rot) in &self.starts {
-            let (sx, sy) = part.spec().footprint(rot);
-            if (sx, sy) != (bounds.sx, bounds.sy) {
+            let p = Placement::new(part, bounds.min, rot);
+            let b = p.body(st.layer_ldu);
+            if b.bbox != bounds {
                 continue;
             }
-            let p = Placement::new(part, bounds.min, rot);
-            if st.is_single_piece(&p) && st.commitment(&bounds, &p).is_some() {
+            if st.is_single_piece(&p) && st.commitment(&b, &p).is_some() && st.face_clear(&b) {
                 return Some(Removal::new_start(p));
             }
         }
@@ -373,7 +378,7 @@ impl<'a> PartSearch<'a> {
                             }
                         }
                         if let Some(c) = self.match_at(st, slot, cell, &mut fit) {
-                            if !built && !st.on_side_boundary(&c.b) {
+                            if !built && !st.on_side_boundary(&c.b.bbox) {
                                 continue;
                             }
                             // With nothing built, the matched piece to continue
@@ -405,7 +410,16 @@ impl<'a> PartSearch<'a> {
         }
     }
 
-    /// The structural match of `slot` with its new piece's minimum corner at
+    /// The piece `part` turned `rot` placed with its key cell (see
+    /// [`Body::key`]) at `cell`, and its body.
+    fn at_key(&self, part: PartKind, rot: Rot, cell: Cell) -> (Placement, Body) {
+        let u = self.rules.layer_ldu();
+        let k = part.body(rot, Cell::new(0, 0, 0), u).key();
+        let p = Placement::new(part, cell.offset(-k.x, -k.y, -k.z), rot);
+        (p, p.body(u))
+    }
+
+    /// The structural match of `slot` with its new piece's key cell at
     /// `cell`: pieces inside the voxels, consistent with matched pieces.
     fn match_at(
         &self,
@@ -417,12 +431,11 @@ impl<'a> PartSearch<'a> {
         match slot {
             Slot::Rule(i) => {
                 let v = &self.rules.variants()[i as usize];
-                let piece = Placement::new(v.added, cell, v.added_rot);
-                let b = boxed(&piece);
+                let (piece, b) = self.at_key(v.added, v.added_rot, cell);
                 let committed = match *fit {
                     Some((p, r, c)) if (p, r) == (v.added, v.added_rot) => c,
                     _ => {
-                        let c = if st.v.all_set(&b) {
+                        let c = if st.v.all_set_body(&b) && st.face_clear(&b) {
                             st.commitment(&b, &piece)
                         } else {
                             None
@@ -432,10 +445,10 @@ impl<'a> PartSearch<'a> {
                     }
                 }?;
                 let (dx, dy, dz) = v.offset;
-                let a_at = cell.offset(-dx, -dy, -dz);
+                let a_at = piece.origin.offset(-dx, -dy, -dz);
                 let anchor = Placement::new(v.anchor, a_at, v.anchor_rot);
-                let a = boxed(&anchor);
-                if !st.v.all_set(&a) {
+                let a = anchor.body(st.layer_ldu);
+                if !st.v.all_set_body(&a) || !st.face_clear(&a) {
                     return None;
                 }
                 let a_committed = st.commitment(&a, &anchor)?;
@@ -449,9 +462,8 @@ impl<'a> PartSearch<'a> {
                 })
             }
             Slot::OnBuilt(part, rot) => {
-                let piece = Placement::new(part, cell, rot);
-                let b = boxed(&piece);
-                if !st.v.all_set(&b) || !st.touches_built(&b) {
+                let (piece, b) = self.at_key(part, rot, cell);
+                if !st.v.all_set_body(&b) || !st.touches_built(&b) || !st.face_clear(&b) {
                     return None;
                 }
                 let committed = st.commitment(&b, &piece)?;
@@ -475,9 +487,10 @@ impl<'a> PartSearch<'a> {
             Some((ab, None)) => Some(ab),
             _ => None,
         };
+        let anchor_bbox = new_anchor.map(|a| a.bbox);
         let ok_place = st.placeable(&c.b);
-        let ok_conn = ok_place && st.still_connected(&c.b, new_anchor.as_ref());
-        let ok = ok_conn && st.still_reachable(&c.b, new_anchor.as_ref());
+        let ok_conn = ok_place && st.still_connected(&c.b.bbox, anchor_bbox.as_ref());
+        let ok = ok_conn && st.still_reachable(&c.b.bbox, anchor_bbox.as_ref());
         if !ok_place {
             stats.rejected_placeable += 1;
         } else if !ok_conn {

@@ -19,10 +19,10 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::dfs::PartResult;
-use super::state::{boxed, Anchor, Removal, State};
+use super::state::{Anchor, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
-use crate::geom::{Cell, CellBox, Rot};
+use crate::geom::{Body, Cell, CellBox, Rot};
 use crate::grammar::RuleSet;
 use crate::voxel::VoxelGrid;
 
@@ -46,9 +46,11 @@ struct Frame {
 /// its lowest layer when nothing is built yet, otherwise from the pieces
 /// that rest on `built`, the structure built before. Voxels that no rule can
 /// join after `max_backtracks_per_part` backtracks are left out of `v`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn grow(
     v: &mut VoxelGrid,
     built: &VoxelGrid,
+    solid: &VoxelGrid,
     rules: &RuleSet,
     opts: &SearchOptions,
     deadline: Instant,
@@ -87,9 +89,10 @@ pub(crate) fn grow(
     let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
 
     let starts = super::start_shapes(rules);
+    let u = rules.layer_ldu();
     let place = |p: &Placement, cover: &mut VoxelGrid, owner: &mut Vec<u32>, id: u32| {
-        let b = boxed(p);
-        cover.set_box(&b, true);
+        let b = p.body(u);
+        cover.set_body(&b, true);
         for c in b.cells() {
             let i = cover.index(c);
             owner[i] = id;
@@ -100,7 +103,7 @@ pub(crate) fn grow(
     // the first piece, the next seed is tried.
     let mut seed_k = 0usize;
     if built.is_empty() {
-        let Some(first) = start_at(v, &starts, seeds[0]) else {
+        let Some(first) = start_at(v, solid, u, &starts, seeds[0]) else {
             return PartResult::Unbuildable;
         };
         place(&first, &mut cover, &mut owner, 0);
@@ -168,17 +171,22 @@ pub(crate) fn grow(
                 } else {
                     starts[(si - n_rules) as usize]
                 };
-                let (sx, sy) = added.spec().footprint(added_rot);
-                while f.corner < (sx * sy) as usize {
-                    let (ox, oy) = (f.corner as i32 % sx, f.corner as i32 / sx);
+                // Every way the piece can lie over the target voxel.
+                let local = added.body(added_rot, Cell::new(0, 0, 0), u);
+                let corners = local.volume() as usize;
+                while f.corner < corners {
+                    let o = local.cells().nth(f.corner).expect("a cell of the body");
                     f.corner += 1;
                     stats.match_tries += 1;
                     if stats.match_tries % 65_536 == 0 && Instant::now() >= deadline {
                         return PartResult::OutOfBudget;
                     }
-                    let p = Placement::new(added, f.target.offset(-ox, -oy, 0), added_rot);
-                    let b = boxed(&p);
-                    if !v.all_set(&b) || cover.any_set(&b) {
+                    let p = Placement::new(added, f.target.offset(-o.x, -o.y, -o.z), added_rot);
+                    let b = p.body(u);
+                    if !v.all_set_body(&b)
+                        || cover.any_set_body(&b)
+                        || !face_clear(solid, built, &b)
+                    {
                         continue;
                     }
                     let anchor = if si < n_rules {
@@ -186,27 +194,28 @@ pub(crate) fn grow(
                         let (dx, dy, dz) = x.offset;
                         let a =
                             Placement::new(x.anchor, p.origin.offset(-dx, -dy, -dz), x.anchor_rot);
-                        if !cover.in_bounds(a.origin) {
+                        let key = a.body(u).key();
+                        if !cover.in_bounds(key) {
                             continue;
                         }
-                        let id = owner[v.index(a.origin)];
+                        let id = owner[v.index(key)];
                         if id == NONE || placed[id as usize].0 != a {
                             continue;
                         }
                         Anchor::Piece(a)
                     } else {
-                        if !b.cells().any(on_built) {
+                        if !State::links(built, &b) {
                             continue;
                         }
                         Anchor::Built
                     };
-                    if !super::state::placeable(&cover, built, &b) {
+                    if !super::state::placeable(&cover, built, &b.bbox) {
                         stats.rejected_placeable += 1;
                         continue;
                     }
-                    cover.set_box(&b, true);
-                    let ok = f.relaxed || still_coverable(v, &cover, built, &b, &shapes);
-                    cover.set_box(&b, false);
+                    cover.set_body(&b, true);
+                    let ok = f.relaxed || still_coverable(v, &cover, built, &b.bbox, &shapes);
+                    cover.set_body(&b, false);
                     if !ok {
                         stats.rejected_reach += 1;
                         continue;
@@ -262,10 +271,10 @@ pub(crate) fn grow(
                     // Stuck right at the start: start elsewhere.
                     seed_k += 1;
                     let (p, _, _) = placed.pop().expect("the first piece");
-                    cover.set_box(&boxed(&p), false);
+                    cover.set_body(&p.body(u), false);
                     owner.iter_mut().for_each(|o| *o = NONE);
                     stack.clear();
-                    if let Some(first) = start_at(v, &starts, seeds[seed_k]) {
+                    if let Some(first) = start_at(v, solid, u, &starts, seeds[seed_k]) {
                         place(&first, &mut cover, &mut owner, 0);
                         placed.push((first, Anchor::Start, None));
                     }
@@ -286,8 +295,8 @@ pub(crate) fn grow(
                 stats.backtracks += 1;
                 backtracks_here += 1;
                 let (p, _, _) = placed.pop().expect("a placed piece per frame");
-                let b = boxed(&p);
-                cover.set_box(&b, false);
+                let b = p.body(u);
+                cover.set_body(&b, false);
                 for c in b.cells() {
                     owner[v.index(c)] = NONE;
                 }
@@ -315,24 +324,38 @@ fn can_ever_cover(v: &VoxelGrid, built: &VoxelGrid, u: Cell, shapes: &[(i32, i32
         .any(|bx| v.all_set(&bx) && (State::touches(v, &bx) || State::touches(built, &bx)))
 }
 
-/// The biggest starting piece that covers `seed` and fits the voxels.
+/// The biggest starting piece that covers `seed` with its bottom layer and
+/// fits the voxels.
 fn start_at(
     v: &VoxelGrid,
+    solid: &VoxelGrid,
+    layer_ldu: i32,
     starts: &[(crate::catalog::PartKind, Rot)],
     seed: Cell,
 ) -> Option<Placement> {
+    let nothing = VoxelGrid::new(1, 1, 1);
     for &(part, rot) in starts {
         let (sx, sy) = part.spec().footprint(rot);
         for oy in 0..sy {
             for ox in 0..sx {
                 let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
-                if v.all_set(&boxed(&p)) {
+                let b = p.body(layer_ldu);
+                if b.contains(seed) && v.all_set_body(&b) && face_clear(solid, &nothing, &b) {
                     return Some(p);
                 }
             }
         }
     }
     None
+}
+
+/// Whether a slope's sloping face, which passes through the cells of its
+/// box it does not fill, keeps clear of the model and the built structure.
+fn face_clear(solid: &VoxelGrid, built: &VoxelGrid, b: &Body) -> bool {
+    b.is_box()
+        || b.bbox
+            .cells()
+            .all(|c| b.contains(c) || (!solid.get(c) && !built.get(c)))
 }
 
 /// Breadth-first distances from `seed` through face-adjacent voxels.

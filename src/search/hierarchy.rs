@@ -150,25 +150,39 @@ pub fn repair_islands(v: &VoxelGrid) -> (VoxelGrid, Repairs) {
 /// a neighbour with something above or below, and a sheet one layer thick
 /// (the bottom layer of a model, a mug's floor, a fin) cannot hold together
 /// at all. Such voxels get the voxel above them (below, at the grid's top).
-pub fn thicken_sheets(v: &mut VoxelGrid, rep: &mut Repairs) {
-    let (_, _, nz) = v.dims();
-    if nz < 2 {
+pub fn thicken_sheets(v: &mut VoxelGrid, rep: &mut Repairs, min_thick: i32) {
+    let (nx, ny, nz) = v.dims();
+    if nz < min_thick {
         return;
     }
-    let bare: Vec<Cell> = v
-        .cells()
-        .filter(|c| !v.get(c.offset(0, 0, 1)) && !v.get(c.offset(0, 0, -1)))
-        .collect();
-    for c in bare {
-        let up = c.offset(0, 0, 1);
-        let add = if v.in_bounds(up) {
-            up
-        } else {
-            c.offset(0, 0, -1)
-        };
-        if !v.get(add) {
-            v.set(add, true);
-            rep.thickened_voxels += 1;
+    for y in 0..ny {
+        for x in 0..nx {
+            let mut z = 0;
+            while z < nz {
+                if !v.get(Cell::new(x, y, z)) {
+                    z += 1;
+                    continue;
+                }
+                let lo = z;
+                while z < nz && v.get(Cell::new(x, y, z)) {
+                    z += 1;
+                }
+                // A run thinner than `min_thick` grows upward, or downward
+                // where the grid ends.
+                let mut top = z;
+                let mut bottom = lo;
+                while top - bottom < min_thick {
+                    if top < nz {
+                        v.set(Cell::new(x, y, top), true);
+                        top += 1;
+                    } else {
+                        bottom -= 1;
+                        v.set(Cell::new(x, y, bottom), true);
+                    }
+                    rep.thickened_voxels += 1;
+                }
+                z = top;
+            }
         }
     }
 }
@@ -213,17 +227,19 @@ fn shortest_support(island: &[Cell], joined: &VoxelGrid, all: &VoxelGrid) -> Opt
 /// the second layer. A part some
 /// of whose pieces could not touch the parts below it (or, for the bottom
 /// part, that is not in one piece) is merged with the part above.
-pub fn split_parts(v: &VoxelGrid, max_layers: i32) -> Vec<VoxelGrid> {
+pub fn split_parts(v: &VoxelGrid, max_layers: i32, course: i32) -> Vec<VoxelGrid> {
     let (nx, ny, nz) = v.dims();
     let counts: Vec<usize> = (0..nz).map(|z| v.count_layer(z)).collect();
     let mut cuts = vec![0];
     let mut start = 0;
-    for z in 1..nz {
+    // Cuts fall between brick courses only: `course` layers make one.
+    for z in (course..nz).step_by(course.max(1) as usize) {
         let (a, b) = (counts[z as usize - 1] as f64, counts[z as usize] as f64);
         let sharp = (a - b).abs() > 0.5 * a.max(b) && (a - b).abs() >= 4.0;
         // The bottom part, which nothing holds from below, is kept to two
-        // layers: its pieces must interlock among themselves.
-        if (sharp && z - start >= 2) || z - start >= max_layers.max(1) || (start == 0 && z == 2) {
+        // courses: its pieces must interlock among themselves.
+        let (two, most) = (2 * course, max_layers.max(1) * course);
+        if (sharp && z - start >= two) || z - start >= most || (start == 0 && z == two) {
             cuts.push(z);
             start = z;
         }
@@ -330,12 +346,12 @@ mod tests {
             },
         ]);
         let mut rep = Repairs::default();
-        thicken_sheets(&mut g, &mut rep);
+        thicken_sheets(&mut g, &mut rep, 2);
         assert_eq!(rep.thickened_voxels, 4);
         assert!((3..7).all(|x| g.get(Cell::new(x, 0, 3))));
         // Nothing bare is left, so a second pass changes nothing.
         let before = g.clone();
-        thicken_sheets(&mut g, &mut rep);
+        thicken_sheets(&mut g, &mut rep, 2);
         assert_eq!(g, before);
     }
 
@@ -356,7 +372,7 @@ mod tests {
                 sz: 5,
             },
         ]);
-        let parts = split_parts(&g, 6);
+        let parts = split_parts(&g, 6, 1);
         let counts: Vec<usize> = parts.iter().map(|p| p.count()).collect();
         assert_eq!(counts, vec![8 * 8 * 2, 8 * 8 + 2 * 2 * 5]);
         // Two legs and a top: the legs part is not one piece, so it merges.
@@ -380,7 +396,7 @@ mod tests {
                 sz: 1,
             },
         ]);
-        let parts = split_parts(&t, 6);
+        let parts = split_parts(&t, 6, 1);
         assert_eq!(parts.len(), 1);
         assert_eq!(parts[0].count(), t.count());
     }

@@ -171,8 +171,14 @@ pub fn build(
     let started = Instant::now();
     let deadline = started + opts.time_budget;
     let (mut fixed, mut repairs) = hierarchy::repair_islands(voxels);
-    hierarchy::thicken_sheets(&mut fixed, &mut repairs);
-    let mut parts = split_parts(&fixed, opts.max_part_layers);
+    // A course is a brick's height in layers; a sheet one course thick is
+    // pieces side by side that cannot hold together, except plates, which
+    // two layers laminate.
+    let course = 24 / rules.layer_ldu();
+    let plates = rules.layer_ldu() == 8;
+    let min_thick = if plates { 2 } else { 2 * course };
+    hierarchy::thicken_sheets(&mut fixed, &mut repairs, min_thick);
+    let mut parts = split_parts(&fixed, opts.max_part_layers, course);
     let mut stats = SearchStats::default();
     let (nx, ny, nz) = fixed.dims();
     let mut built = VoxelGrid::new(nx, ny, nz);
@@ -182,16 +188,20 @@ pub fn build(
     let mut finished = parts.len();
     for (i, part) in parts.iter_mut().enumerate() {
         let result = if built.is_empty() {
-            grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
+            grow::grow(
+                part, &built, &fixed, rules, opts, deadline, &mut rng, &mut stats,
+            )
         } else {
             // About twice the pieces the part needs: enough when the trace
             // goes straight through, and little lost when it does not.
             let budget = (part.count() as u64 / 2 + 256).min(opts.max_nodes_per_part);
-            match search.run(part.clone(), &built, budget, &mut rng, &mut stats) {
+            match search.run(part.clone(), &built, &fixed, budget, &mut rng, &mut stats) {
                 PartResult::Built(t) => PartResult::Built(t),
                 _ if Instant::now() < deadline => {
                     stats.fallbacks += 1;
-                    grow::grow(part, &built, rules, opts, deadline, &mut rng, &mut stats)
+                    grow::grow(
+                        part, &built, &fixed, rules, opts, deadline, &mut rng, &mut stats,
+                    )
                 }
                 other => other,
             }
@@ -199,7 +209,7 @@ pub fn build(
         match result {
             PartResult::Built(trace) => {
                 for r in trace.iter().rev() {
-                    built.set_box(&r.piece.cells_box(crate::grammar::PLATES_PER_LAYER), true);
+                    built.set_body(&r.piece.body(rules.layer_ldu()), true);
                     order.push(*r);
                 }
             }
@@ -249,7 +259,7 @@ pub fn build(
 pub(crate) fn start_shapes(rules: &RuleSet) -> Vec<(crate::catalog::PartKind, crate::geom::Rot)> {
     let mut starts = Vec::new();
     for s in rules.starts() {
-        for rot in [crate::geom::Rot::R0, crate::geom::Rot::R90] {
+        for rot in crate::geom::Rot::ALL {
             let r = s.part.spec().canonical_rot(rot);
             if !starts.contains(&(s.part, r)) {
                 starts.push((s.part, r));
@@ -285,10 +295,13 @@ pub fn placements(outcome: &SearchOutcome) -> Vec<Placement> {
 mod tests {
     use super::*;
     use crate::geom::{Cell, CellBox};
-    use crate::grammar::{default_rules_text, PLATES_PER_LAYER};
+    use crate::grammar::default_rules_text;
 
     fn rules() -> RuleSet {
-        RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap()
+        RuleSet::parse(&default_rules_text(), "default.rules".as_ref())
+            .unwrap()
+            .restricted(|p| p.spec().family() == crate::catalog::Family::Brick)
+            .unwrap()
     }
 
     fn grid(dims: (i32, i32, i32), boxes: &[CellBox]) -> VoxelGrid {
@@ -312,11 +325,7 @@ mod tests {
     fn check(out: &SearchOutcome) {
         let (nx, ny, nz) = out.voxels.dims();
         let mut seen = VoxelGrid::new(nx, ny, nz);
-        let boxes: Vec<CellBox> = out
-            .order
-            .iter()
-            .map(|r| r.piece.cells_box(PLATES_PER_LAYER))
-            .collect();
+        let boxes: Vec<CellBox> = out.order.iter().map(|r| r.piece.body(24).bbox).collect();
         for (i, b) in boxes.iter().enumerate() {
             assert!(!seen.any_set(b), "piece {i} overlaps");
             seen.set_box(b, true);
@@ -408,7 +417,10 @@ mod part_tests {
     use crate::grammar::default_rules_text;
 
     fn rules() -> RuleSet {
-        RuleSet::parse(&default_rules_text(), "default.rules".as_ref()).unwrap()
+        RuleSet::parse(&default_rules_text(), "default.rules".as_ref())
+            .unwrap()
+            .restricted(|p| p.spec().family() == crate::catalog::Family::Brick)
+            .unwrap()
     }
 
     /// Backward tracing alone builds boxes resting on a built base: every
@@ -442,11 +454,12 @@ mod part_tests {
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let voxels = g.count();
-            let PartResult::Built(trace) = search.run(g, &built, 100_000, &mut rng, &mut stats)
+            let PartResult::Built(trace) =
+                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
-            let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
+            let covered: i32 = trace.iter().map(|r| r.piece.body(24).volume()).sum();
             assert_eq!(covered as usize, voxels);
             assert!(
                 trace.iter().any(|r| r.rule.is_some()),
@@ -481,11 +494,12 @@ mod part_tests {
             let search = PartSearch::new(&rules, &o, Instant::now() + Duration::from_secs(60));
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let PartResult::Built(trace) = search.run(g, &built, 100_000, &mut rng, &mut stats)
+            let PartResult::Built(trace) =
+                search.run(g.clone(), &built, &g, 100_000, &mut rng, &mut stats)
             else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
-            let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
+            let covered: i32 = trace.iter().map(|r| r.piece.body(24).volume()).sum();
             assert_eq!(covered, sx * sy * sz);
             assert_eq!(trace.last().map(|r| r.anchor), Some(Anchor::Start));
         }
@@ -512,9 +526,11 @@ mod part_tests {
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let built = VoxelGrid::new(sx, sy, 2);
             let before = g.count();
+            let solid = g.clone();
             let r = grow::grow(
                 &mut g,
                 &built,
+                &solid,
                 &rules,
                 &o,
                 Instant::now() + Duration::from_secs(60),
@@ -525,7 +541,7 @@ mod part_tests {
                 panic!("{sx}x{sy} not built")
             };
             assert_eq!(g.count(), before, "{sx}x{sy}: voxels left out: {stats:?}");
-            let covered: i32 = trace.iter().map(|r| r.piece.cells_box(3).volume()).sum();
+            let covered: i32 = trace.iter().map(|r| r.piece.body(24).volume()).sum();
             assert_eq!(covered as usize, before);
             assert_eq!(
                 trace.iter().filter(|r| r.anchor == Anchor::Start).count(),

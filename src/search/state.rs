@@ -6,8 +6,8 @@
 //! path applied, and undoing a removal restores the parent.
 
 use crate::assembly::Placement;
-use crate::geom::{Cell, CellBox};
-use crate::grammar::{piece_box, RuleId, PLATES_PER_LAYER};
+use crate::geom::{Body, Cell, CellBox};
+use crate::grammar::RuleId;
 use crate::voxel::VoxelGrid;
 
 /// Positions the placeability flood fill visits before it gives up.
@@ -76,6 +76,11 @@ pub(crate) struct State<'g> {
     pub v: VoxelGrid,
     /// The structure built before this part: obstacles and anchors.
     pub built: &'g VoxelGrid,
+    /// Every voxel of the model, all parts: what a slope's sloping face
+    /// must keep clear of.
+    solid: &'g VoxelGrid,
+    /// Height of a layer in LDU.
+    pub layer_ldu: i32,
     /// Committed piece per cell (or [`NONE`]).
     owner: Vec<u32>,
     /// Committed pieces; `alive` is false once peeled.
@@ -92,12 +97,20 @@ pub(crate) struct State<'g> {
 }
 
 impl<'g> State<'g> {
-    pub fn new(v: VoxelGrid, built: &'g VoxelGrid, footprints: Vec<(i32, i32)>) -> Self {
+    pub fn new(
+        v: VoxelGrid,
+        built: &'g VoxelGrid,
+        solid: &'g VoxelGrid,
+        layer_ldu: i32,
+        footprints: Vec<(i32, i32)>,
+    ) -> Self {
         let len = v.len();
         let (nx, ny, nz) = v.dims();
         State {
             v,
             built,
+            solid,
+            layer_ldu,
             owner: vec![NONE; len],
             pieces: Vec::new(),
             peeled: VoxelGrid::new(nx, ny, nz),
@@ -115,8 +128,8 @@ impl<'g> State<'g> {
 
     /// `Some(None)` if no cell of `b` is committed, `Some(Some(id))` if `b`
     /// is exactly committed piece `id`, `None` if it cuts a committed piece.
-    pub fn commitment(&self, b: &CellBox, p: &Placement) -> Option<Option<u32>> {
-        let first = self.owner[self.v.index(b.min)];
+    pub fn commitment(&self, b: &Body, p: &Placement) -> Option<Option<u32>> {
+        let first = self.owner[self.v.index(b.key())];
         if first == NONE {
             for c in b.cells() {
                 if self.owner[self.v.index(c)] != NONE {
@@ -132,9 +145,24 @@ impl<'g> State<'g> {
         }
     }
 
-    /// Whether `b`'s footprint touches cells of `g` directly above or below.
+    /// Whether a one-layer box touches cells of `g` directly above or below.
     pub(crate) fn touches(g: &VoxelGrid, b: &CellBox) -> bool {
         g.any_set(&b.layer_below()) || g.any_set(&b.layer_above())
+    }
+
+    /// Whether cells of `g` sit where they could stud-connect to `b`: on
+    /// its studs or under its tubes.
+    pub(crate) fn links(g: &VoxelGrid, b: &Body) -> bool {
+        g.any_set(&b.under_tubes()) || g.any_set(&b.over_studs())
+    }
+
+    /// Whether a slope's sloping face, which passes through the cells of
+    /// its box it does not fill, keeps clear of every voxel of the model.
+    pub fn face_clear(&self, b: &Body) -> bool {
+        b.is_box()
+            || b.bbox
+                .cells()
+                .all(|c| b.contains(c) || (!self.solid.get(c) && !self.built.get(c)))
     }
 
     /// Whether any committed piece is still in the grid.
@@ -160,18 +188,18 @@ impl<'g> State<'g> {
     }
 
     /// Whether `b` stud-connects to the structure built before this part.
-    pub fn touches_built(&self, b: &CellBox) -> bool {
-        Self::touches(self.built, b)
+    pub fn touches_built(&self, b: &Body) -> bool {
+        Self::links(self.built, b)
     }
 
     /// Whether `b` connects to a piece matched earlier (the paper's
     /// connection-constrained matching): a committed piece or a peeled one
     /// directly above or below, or the structure built before.
-    pub fn touches_matched(&self, b: &CellBox) -> bool {
-        if Self::touches(&self.peeled, b) || self.touches_built(b) {
+    pub fn touches_matched(&self, b: &Body) -> bool {
+        if Self::links(&self.peeled, b) || self.touches_built(b) {
             return true;
         }
-        [b.layer_below(), b.layer_above()].iter().any(|n| {
+        [b.under_tubes(), b.over_studs()].iter().any(|n| {
             n.cells()
                 .any(|c| self.v.in_bounds(c) && self.owner[self.v.index(c)] != NONE)
         })
@@ -181,13 +209,13 @@ impl<'g> State<'g> {
     pub fn apply(
         &mut self,
         piece: Placement,
-        b: &CellBox,
+        b: &Body,
         was_committed: Option<u32>,
         anchor: Anchor,
-        anchor_box: Option<(&CellBox, Option<u32>)>,
+        anchor_box: Option<(&Body, Option<u32>)>,
         rule: Option<RuleId>,
     ) -> Removal {
-        self.v.set_box(b, false);
+        self.v.set_body(b, false);
         if let Some(id) = was_committed {
             self.pieces[id as usize].1 = false;
             for c in b.cells() {
@@ -195,7 +223,7 @@ impl<'g> State<'g> {
                 self.owner[i] = NONE;
             }
         }
-        self.peeled.set_box(b, true);
+        self.peeled.set_body(b, true);
         let mut new_anchor = None;
         if let (Anchor::Piece(ap), Some((abox, None))) = (anchor, anchor_box) {
             let id = self.pieces.len() as u32;
@@ -220,17 +248,17 @@ impl<'g> State<'g> {
 
     /// Undoes `r`, which must be the last applied removal.
     pub fn undo(&mut self, r: &Removal) {
-        let b = r.piece.cells_box(PLATES_PER_LAYER);
+        let b = r.piece.body(self.layer_ldu);
         if let Some(id) = r.new_anchor {
             let (ap, _) = self.pieces.pop().expect("anchor stack");
             debug_assert_eq!(id as usize, self.pieces.len());
-            for c in ap.cells_box(PLATES_PER_LAYER).cells() {
+            for c in ap.body(self.layer_ldu).cells() {
                 let i = self.v.index(c);
                 self.owner[i] = NONE;
             }
         }
-        self.peeled.set_box(&b, false);
-        self.v.set_box(&b, true);
+        self.peeled.set_body(&b, false);
+        self.v.set_body(&b, true);
         if let Some(id) = r.was_committed {
             self.pieces[id as usize].1 = true;
             for c in b.cells() {
@@ -245,8 +273,8 @@ impl<'g> State<'g> {
 
     /// The free-space check of the paper for `b`, already peeled: see
     /// [`placeable`].
-    pub fn placeable(&self, b: &CellBox) -> bool {
-        placeable(&self.v, self.built, b)
+    pub fn placeable(&self, b: &Body) -> bool {
+        placeable(&self.v, self.built, &b.bbox)
     }
 
     fn horizontal_edge(&self, a: usize, b: usize) -> bool {
@@ -461,14 +489,9 @@ impl<'g> State<'g> {
     /// The committed piece the grid holds whole at `p`, if `p` is exactly the
     /// remaining voxels (the last piece, for a starting rule).
     pub fn is_single_piece(&self, p: &Placement) -> bool {
-        let b = p.cells_box(PLATES_PER_LAYER);
-        self.v.count() == b.volume() as usize && self.v.all_set(&b)
+        let b = p.body(self.layer_ldu);
+        self.v.count() == b.volume() as usize && self.v.all_set_body(&b)
     }
-}
-
-/// The box a placement fills in a brick grid.
-pub(crate) fn boxed(p: &Placement) -> CellBox {
-    piece_box(p.part, p.rot, p.origin)
 }
 
 /// The free-space check of the paper: can the piece `b` be brought to its

@@ -1,6 +1,6 @@
 //! A dense bitset of voxels, one bit a cell, rows of 64-bit words.
 
-use crate::geom::{Cell, CellBox};
+use crate::geom::{Body, Cell, CellBox};
 
 /// A dense 3D bitset over `nx * ny * nz` cells; `x` is the fastest axis.
 ///
@@ -147,6 +147,23 @@ impl VoxelGrid {
             }
         }
         false
+    }
+
+    /// Whether every cell a piece fills is filled here.
+    pub fn all_set_body(&self, b: &Body) -> bool {
+        b.boxes().iter().all(|x| self.all_set(x))
+    }
+
+    /// Whether any cell a piece fills is filled here.
+    pub fn any_set_body(&self, b: &Body) -> bool {
+        b.boxes().iter().any(|x| self.any_set(x))
+    }
+
+    /// Fills or clears every cell a piece fills (inside the grid).
+    pub fn set_body(&mut self, b: &Body, on: bool) {
+        for x in b.boxes() {
+            self.set_box(x, on);
+        }
     }
 
     /// Fills or clears every cell of `b` (which must lie inside the grid).

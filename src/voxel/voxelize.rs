@@ -116,13 +116,27 @@ impl Default for Sizing {
 
 /// Options for [`voxelize`].
 ///
-/// Defaults: [`Sizing::Studs`]`(24)` and [`Up::Y`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+/// Defaults: [`Sizing::Studs`]`(24)`, [`Up::Y`] and brick-high layers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct VoxelizeOptions {
     /// How big the model is built. Default: 24 studs across.
     pub sizing: Sizing,
     /// The input's up axis. Default: `y`.
     pub up: Up,
+    /// A layer's height in LDU: 24 (a brick, the default), 12 (half a
+    /// brick, with slopes: a slope's sloping face then shows as a step of
+    /// one layer the matcher fits the slope's cells to) or 8 (a plate).
+    pub layer_ldu: i32,
+}
+
+impl Default for VoxelizeOptions {
+    fn default() -> Self {
+        VoxelizeOptions {
+            sizing: Sizing::default(),
+            up: Up::default(),
+            layer_ldu: 24,
+        }
+    }
 }
 
 impl VoxelizeOptions {
@@ -135,6 +149,12 @@ impl VoxelizeOptions {
     /// These options with `up` replaced.
     pub fn with_up(mut self, up: Up) -> Self {
         self.up = up;
+        self
+    }
+
+    /// These options with layers `layer_ldu` high (24, 12, 8 or 4).
+    pub fn with_layer_ldu(mut self, layer_ldu: i32) -> Self {
+        self.layer_ldu = layer_ldu;
         self
     }
 }
@@ -235,7 +255,8 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
     let ext = hi - lo;
-    let ratio = f64::from(LAYER_HEIGHT_STUDS);
+    let brick = f64::from(LAYER_HEIGHT_STUDS);
+    let ratio = brick * f64::from(opts.layer_ldu) / 24.0;
     let stud = match opts.sizing {
         Sizing::Studs(0) | Sizing::Height(0) => return Err(VoxelizeError::ZeroSize),
         Sizing::Studs(n) => {
@@ -255,7 +276,7 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
                     other: "studs",
                 });
             }
-            ext.z / (f64::from(n) * ratio)
+            ext.z / (f64::from(n) * brick)
         }
     };
     let cell = DVec3::new(stud, stud, stud * ratio);
@@ -279,7 +300,7 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
     Ok(VoxelModel {
         grid,
         stud_size: stud as f32,
-        layer_height_studs: LAYER_HEIGHT_STUDS,
+        layer_height_studs: ratio as f32,
         origin: origin.as_vec3(),
     })
 }

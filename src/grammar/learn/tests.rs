@@ -6,27 +6,42 @@ use std::path::{Path, PathBuf};
 use super::*;
 use crate::geom::Cell;
 use crate::grammar::defaults::generate;
-use crate::grammar::{piece_box, Variant, DEFAULT_ALPHABET};
+use crate::grammar::{Variant, DEFAULT_ALPHABET};
 use crate::ldraw::{parse_ldr, placement_position, rot_matrix};
 
 fn kind(id: &str) -> PartKind {
     PartKind::from_id(id).unwrap()
 }
 
-/// A brick at grid cell `(x, y, z)` (z in brick layers) turned by `rot`.
+/// A brick's height in LDU: the layers of [`pl`] and [`build_text`].
+const BRICK: i32 = 24;
+
+/// A plate's height in LDU: the layers of [`build_text_in`] for builds
+/// with plates.
+const PLATE: i32 = 8;
+
+/// A piece at grid cell `(x, y, z)` turned by `rot`; `z` counts layers of
+/// the grid the build is written in (brick layers for [`build_text`]).
 fn pl(id: &str, x: i32, y: i32, z: i32, rot: Rot) -> Placement {
     Placement::new(kind(id), Cell::new(x, y, z), rot)
 }
 
 /// `p` with the whole build turned by `t` about the vertical axis.
 fn turned(p: &Placement, t: Rot) -> Placement {
-    let b = turn_box(&p.cells_box(3), t);
+    // Any layer height that divides every part's will do: turns keep z.
+    let b = p.body(PLATE).bbox.turned(t);
     Placement::new(p.part, b.min, p.rot.then(t))
 }
 
-/// The LDraw line of `p` (a brick grid) in colour `color`.
+/// The LDraw line of `p` (in a grid of brick layers) in colour `color`.
 fn line(p: &Placement, color: u16) -> String {
-    let [x, y, z] = placement_position(p, 3);
+    line_in(BRICK, p, color)
+}
+
+/// The LDraw line of `p`, in a grid of `layer_ldu`-high layers, in colour
+/// `color`.
+fn line_in(layer_ldu: i32, p: &Placement, color: u16) -> String {
+    let [x, y, z] = placement_position(p, layer_ldu);
     let m = rot_matrix(p.rot)
         .concat()
         .iter()
@@ -36,9 +51,18 @@ fn line(p: &Placement, color: u16) -> String {
     format!("1 {color} {x} {y} {z} {m} {}.dat\n", p.part)
 }
 
-/// A build of `pieces` in order, one step each, in red.
+/// A build of `pieces` (in brick layers) in order, one step each, in red.
 fn build_text(pieces: &[Placement]) -> String {
-    pieces.iter().map(|p| line(p, 4) + "0 STEP\n").collect()
+    build_text_in(BRICK, pieces)
+}
+
+/// A build of `pieces`, in a grid of `layer_ldu`-high layers, in order, one
+/// step each, in red.
+fn build_text_in(layer_ldu: i32, pieces: &[Placement]) -> String {
+    pieces
+        .iter()
+        .map(|p| line_in(layer_ldu, p, 4) + "0 STEP\n")
+        .collect()
 }
 
 fn model(text: &str, name: &str) -> LdrModel {
@@ -215,13 +239,13 @@ fn a_separately_built_submodel_counts_inside_but_not_where_attached() {
 fn parts_outside_the_catalog_are_skipped_and_reported() {
     let text = "\
 1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat
-1 4 40 -32 20 1 0 0 0 1 0 0 0 1 3020.dat
+1 4 40 -32 20 1 0 0 0 1 0 0 0 1 87079.dat
 1 4 40 -56 20 1 0 0 0 1 0 0 0 1 3001.DAT
-1 4 40 -64 20 1 0 0 0 1 0 0 0 1 3020.dat
+1 4 40 -64 20 1 0 0 0 1 0 0 0 1 87079.dat
 1 4 0 0 0 1 0 0 0 0 -1 0 1 0 6141.dat
 ";
     let l = learn_one(text);
-    // The bricks sit on plates, never on each other: nothing to count.
+    // The bricks sit on tiles, never on each other: nothing to count.
     assert!(l.counts.is_empty());
     let r = &l.report;
     assert_eq!((r.pieces, r.learned_pieces), (5, 2));
@@ -230,7 +254,7 @@ fn parts_outside_the_catalog_are_skipped_and_reported() {
         .iter()
         .map(|s| (s.part.as_str(), s.count, s.first.line))
         .collect();
-    assert_eq!(skipped, [("3020", 2, 2), ("6141", 1, 5)]);
+    assert_eq!(skipped, [("87079", 2, 2), ("6141", 1, 5)]);
     assert_eq!(r.skipped[0].first.file, Path::new("t.ldr"));
     assert_eq!(r.parts, [kind("3001")]);
     let summary = l.summary();
@@ -239,7 +263,7 @@ fn parts_outside_the_catalog_are_skipped_and_reported() {
         "{summary}"
     );
     assert!(
-        summary.contains("2 x 3020       first at t.ldr:2"),
+        summary.contains("2 x 87079      first at t.ldr:2"),
         "{summary}"
     );
 }
@@ -323,12 +347,13 @@ fn variant_key(v: &Variant) -> VariantKey {
     )
 }
 
-/// The variant an observed joint of `b` to `a` is, in the rule-set grid.
-fn observed_variant(a: &Placement, b: &Placement, dir: Dir) -> VariantKey {
-    let (ab, bb) = (a.cells_box(3), b.cells_box(3));
+/// The variant an observed joint of `b` to `a` is, in a rule set's grid of
+/// `layer_ldu`-high layers.
+fn observed_variant(a: &Placement, b: &Placement, dir: Dir, layer_ldu: i32) -> VariantKey {
+    let (ab, bb) = (a.body(layer_ldu).bbox, b.body(layer_ldu).bbox);
     let dz = match dir {
-        Dir::Up => piece_box(a.part, a.rot, a.origin).sz,
-        Dir::Down => -piece_box(b.part, b.rot, b.origin).sz,
+        Dir::Up => ab.sz,
+        Dir::Down => -bb.sz,
     };
     let offset = (bb.min.x - ab.min.x, bb.min.y - ab.min.y, dz);
     (a.part, a.rot, b.part, b.rot, offset, dir)
@@ -336,31 +361,49 @@ fn observed_variant(a: &Placement, b: &Placement, dir: Dir) -> VariantKey {
 
 #[test]
 fn the_learned_rule_set_has_exactly_the_variants_of_the_observed_joints() {
-    // Every joint of the default alphabet: each pair of parts, each turn of
-    // the new piece, each overlapping offset, up and down, each built once
-    // with the whole pair turned some way.
+    // Every joint of the default alphabet (bricks, plates and slopes): each
+    // pair of parts, each turn of the new piece, each overlapping offset,
+    // up and down, each built once with the whole pair turned some way.
+    // Where the footprints overlap but no stud meets a tube (on a slope's
+    // front row), the pair is built too and must count nothing.
     let parts: Vec<PartKind> = DEFAULT_ALPHABET.iter().map(|id| kind(id)).collect();
+    let rule_layer = crate::grammar::layer_ldu_for(&parts);
     let mut learner = Learner::new();
     let mut observed: BTreeSet<VariantKey> = BTreeSet::new();
-    let mut joints = 0u64;
+    let (mut joints, mut apart) = (0u64, 0u64);
     for &a in &parts {
         for &b in &parts {
             for rot in Rot::ALL {
                 let (ax, ay) = a.spec().footprint(Rot::R0);
                 let (bx, by) = b.spec().footprint(rot);
+                // In plate layers, A three bricks up; B on it or under it.
+                let z0 = 9;
                 for dir in [Dir::Up, Dir::Down] {
-                    let z = if dir == Dir::Up { 2 } else { 0 };
+                    let z = match dir {
+                        Dir::Up => z0 + a.spec().height_ldu() / PLATE,
+                        Dir::Down => z0 - b.spec().height_ldu() / PLATE,
+                    };
                     for dy in 1 - by..ay {
                         for dx in 1 - bx..ax {
-                            let t =
-                                Rot::from_quarter_turns((dx + 2 * dy + joints as i32) as u8 & 3);
-                            let pa = turned(&Placement::new(a, Cell::new(0, 0, 1), Rot::R0), t);
-                            let pb = turned(&Placement::new(b, Cell::new(dx, dy, z), rot), t);
-                            let text = build_text(&[pa, pb]);
+                            let n = joints + apart;
+                            let t = Rot::from_quarter_turns((dx + 2 * dy + n as i32) as u8 & 3);
+                            let pa = Placement::new(a, Cell::new(0, 0, z0), Rot::R0);
+                            let pb = Placement::new(b, Cell::new(dx, dy, z), rot);
+                            let (ba, bb) = (pa.body(PLATE), pb.body(PLATE));
+                            let linked = match dir {
+                                Dir::Up => ba.holds(&bb),
+                                Dir::Down => bb.holds(&ba),
+                            };
+                            let (pa, pb) = (turned(&pa, t), turned(&pb, t));
+                            let text = build_text_in(PLATE, &[pa, pb]);
                             learner.add(&model(&text, "joint.ldr")).unwrap();
+                            if !linked {
+                                apart += 1;
+                                continue;
+                            }
                             for u in Rot::ALL {
                                 let (ta, tb) = (turned(&pa, u), turned(&pb, u));
-                                observed.insert(observed_variant(&ta, &tb, dir));
+                                observed.insert(observed_variant(&ta, &tb, dir, rule_layer));
                             }
                             joints += 1;
                         }
@@ -369,6 +412,11 @@ fn the_learned_rule_set_has_exactly_the_variants_of_the_observed_joints() {
             }
         }
     }
+    // Slopes leave some overlaps unconnected; bricks and plates none.
+    assert!(
+        apart > 0 && joints > apart,
+        "{joints} joints, {apart} apart"
+    );
     let l = learner.finish().unwrap();
     assert_eq!(l.total(), joints);
 
@@ -485,8 +533,8 @@ fn bad_builds_are_errors_naming_file_and_line() {
             "t.ldr:2: part `3001.dat` is off the grid: X = 45 LDU but 3001 turned r0 must sit at X = 20*n + 40",
         ),
         (
-            format!("{brick}1 4 40 -28 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
-            "t.ldr:2: part `3001.dat` is off the grid: Y = -28 LDU but 3001 must sit at Y = -(8*n + 24) to stand on the plate grid",
+            format!("{brick}1 4 40 -26 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
+            "t.ldr:2: part `3001.dat` is off the grid: Y = -26 LDU but 3001 must sit at Y = -(4*n + 24) to stand on the plate grid",
         ),
         (
             format!("{brick}0 c\n1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n"),
@@ -501,20 +549,22 @@ fn bad_builds_are_errors_naming_file_and_line() {
             "t.ldr: nothing to learn from: it has no part references (type-1 lines)",
         ),
         (
-            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3024.dat\n1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3020.dat\n\
-             1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3024.dat\n"
+            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3068b.dat\n1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n\
+             1 4 0 -8 0 1 0 0 0 1 0 0 0 1 3068b.dat\n"
                 .to_string(),
-            "t.ldr: nothing to learn from: its 3 part references are all outside brickwright's catalog (3020, 3024)",
+            "t.ldr: nothing to learn from: its 3 part references are all outside brickwright's catalog (3068b, 87079)",
         ),
     ];
     for (text, want) in cases {
         let e = learn_err(&text);
         assert!(e.starts_with(want), "got  {e}\nwant {want}");
     }
-    // A plate-high step is on the plate grid: fine.
-    learn_one(&format!(
-        "{brick}1 4 40 -32 20 1 0 0 0 1 0 0 0 1 3001.dat\n"
-    ));
+    // A plate-high step, and a half-plate one, are on the grid: fine.
+    for y in [-32, -28] {
+        learn_one(&format!(
+            "{brick}1 4 40 {y} 20 1 0 0 0 1 0 0 0 1 3001.dat\n"
+        ));
+    }
 
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.ldr");
@@ -528,6 +578,172 @@ fn bad_builds_are_errors_naming_file_and_line() {
         "{e}"
     );
     assert!(matches!(learn(&[]), Err(LearnError::NoBuilds)));
+}
+
+/// Loads `l`'s rule file and checks it is `l`'s rule set and every variant
+/// stud-connects its pieces.
+fn loads(l: &Learned) -> RuleSet {
+    let rs = RuleSet::parse(&l.to_rules_text(), Path::new("l.rules")).unwrap();
+    assert_eq!(rs.variants(), l.rule_set().variants());
+    for v in rs.variants() {
+        let a = rs.body(v.anchor, v.anchor_rot, Cell::new(0, 0, 0));
+        let (dx, dy, dz) = v.offset;
+        let b = rs.body(v.added, v.added_rot, Cell::new(dx, dy, dz));
+        match v.dir {
+            Dir::Up => assert!(a.holds(&b), "{v:?}"),
+            Dir::Down => assert!(b.holds(&a), "{v:?}"),
+        }
+    }
+    rs
+}
+
+#[test]
+fn a_slope_on_a_brick_and_a_brick_on_a_slopes_back_row_are_learned() {
+    // A 2x2 slope on a 2x4, its studded back row (the part's +y) at y = 1,
+    // then a 1x2 on that back row; the whole build turned each way.
+    let pieces = [
+        pl("3001", 0, 0, 0, Rot::R0),
+        pl("3039", 1, 0, 1, Rot::R0),
+        pl("3004", 1, 1, 2, Rot::R0),
+    ];
+    for t in Rot::ALL {
+        let turned_pieces: Vec<Placement> = pieces.iter().map(|p| turned(p, t)).collect();
+        let l = learn_one(&build_text(&turned_pieces));
+        assert_eq!(
+            counts(&l),
+            [
+                (key("3001", "3039", Dir::Up, Rot::R0, 1, 0), 1),
+                (key("3039", "3004", Dir::Up, Rot::R0, 0, 1), 1),
+            ],
+            "{t:?}"
+        );
+        assert_eq!((l.report.starts, l.report.layer_ldu), (1, BRICK));
+        let rs = loads(&l);
+        // Slopes look different every way: four variants a rule.
+        assert_eq!((rs.rules().len(), rs.variants().len()), (2, 8));
+        assert_eq!(rs.layer_ldu(), 12);
+        let text = l.to_rules_text();
+        assert!(
+            text.contains("\nrule 3001   3039   r0   up      1   0  1\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("\nrule 3039   3004   r0   up      0   1  1\n"),
+            "{text}"
+        );
+    }
+    // Facing the other way on the brick, the slope makes the same joint
+    // (the 2x4 looks the same turned a half turn); turned a quarter, it
+    // makes another.
+    for (rot, want) in [
+        (Rot::R180, Rot::R0),
+        (Rot::R90, Rot::R90),
+        (Rot::R270, Rot::R90),
+    ] {
+        let l = learn_one(&build_text(&[
+            pl("3001", 0, 0, 0, Rot::R0),
+            pl("3039", 1, 0, 1, rot),
+        ]));
+        assert_eq!(
+            counts(&l),
+            [(key("3001", "3039", Dir::Up, want, 1, 0), 1)],
+            "{rot:?}"
+        );
+        loads(&l);
+    }
+}
+
+#[test]
+fn a_piece_on_a_slopes_front_row_is_not_connected() {
+    // The front row (y = 0) has no studs: a 1x2 on it holds nothing, turned
+    // any way; a 2x2 over both rows holds on to the back row.
+    let slope = pl("3039", 0, 0, 0, Rot::R0);
+    for t in Rot::ALL {
+        let on_front = [slope, pl("3004", 0, 0, 1, Rot::R0)].map(|p| turned(&p, t));
+        let l = learn_one(&build_text(&on_front));
+        assert!(l.counts.is_empty(), "{t:?}: {:?}", counts(&l));
+        assert_eq!(l.report.starts, 2);
+        let over_both = [slope, pl("3003", 0, 0, 1, Rot::R0)].map(|p| turned(&p, t));
+        let l = learn_one(&build_text(&over_both));
+        assert_eq!(
+            counts(&l),
+            [(key("3039", "3003", Dir::Up, Rot::R0, 0, 0), 1)],
+            "{t:?}"
+        );
+        loads(&l);
+    }
+    // An inverted slope takes studs from below under its back row only.
+    let inverted = pl("3660a", 0, 0, 1, Rot::R0);
+    let l = learn_one(&build_text(&[inverted, pl("3004", 0, 0, 0, Rot::R0)]));
+    assert!(l.counts.is_empty(), "{:?}", counts(&l));
+    let l = learn_one(&build_text(&[inverted, pl("3004", 0, 1, 0, Rot::R0)]));
+    assert_eq!(
+        counts(&l),
+        [(key("3660a", "3004", Dir::Down, Rot::R0, 0, 1), 1)]
+    );
+    loads(&l);
+}
+
+#[test]
+fn a_plate_on_a_brick_counts() {
+    // In plate layers: a 2x4 brick, a 2x4 plate half on it, a 2x4 brick on
+    // the plate.
+    let l = learn_one(&build_text_in(
+        PLATE,
+        &[
+            pl("3001", 0, 0, 0, Rot::R0),
+            pl("3020", 2, 0, 3, Rot::R0),
+            pl("3001", 2, 0, 4, Rot::R0),
+        ],
+    ));
+    assert_eq!(
+        counts(&l),
+        [
+            (key("3001", "3020", Dir::Up, Rot::R0, -2, 0), 1),
+            (key("3020", "3001", Dir::Up, Rot::R0, 0, 0), 1),
+        ]
+    );
+    assert_eq!(l.report.layer_ldu, PLATE);
+    let rs = loads(&l);
+    assert_eq!(rs.layer_ldu(), PLATE);
+    // Pressed on from below: down.
+    let l = learn_one(&build_text_in(
+        PLATE,
+        &[pl("3001", 0, 0, 1, Rot::R0), pl("3020", 0, 0, 0, Rot::R90)],
+    ));
+    assert_eq!(
+        counts(&l),
+        [(key("3001", "3020", Dir::Down, Rot::R90, 0, 0), 1)]
+    );
+    loads(&l);
+}
+
+#[test]
+fn one_grid_for_the_whole_run_and_the_rules_do_not_depend_on_it() {
+    // A stack of two 2x4s, learned alone and beside builds that need finer
+    // layers: 1x1s half a brick apart (12 LDU), a plate (8), both (4).
+    let stack = build_text(&[pl("3001", 0, 0, 0, Rot::R0), pl("3001", 1, 0, 1, Rot::R0)]);
+    let half = "1 4 10 -24 10 1 0 0 0 1 0 0 0 1 3005.dat\n\
+                1 4 110 -36 10 1 0 0 0 1 0 0 0 1 3005.dat\n";
+    let plate = "1 4 10 -8 10 1 0 0 0 1 0 0 0 1 3024.dat\n";
+    let alone = learn_one(&stack);
+    assert_eq!(alone.report.layer_ldu, BRICK);
+    assert_eq!(
+        counts(&alone),
+        [(key("3001", "3001", Dir::Up, Rot::R0, -1, 0), 1)]
+    );
+    for (others, layer) in [(vec![half], 12), (vec![plate], 8), (vec![half, plate], 4)] {
+        let mut builds = vec![("stack.ldr", stack.as_str())];
+        builds.extend(others.iter().map(|t| ("other.ldr", *t)));
+        let l = learn_texts(&builds).unwrap();
+        assert_eq!(l.report.layer_ldu, layer);
+        assert_eq!(l.counts, alone.counts, "at {layer} LDU");
+        loads(&l);
+    }
+    // A build lifted off the ground by half a plate is the same build.
+    let lifted = stack.replace(" -24 ", " -28 ").replace(" -48 ", " -52 ");
+    let l = learn_one(&lifted);
+    assert_eq!((l.report.layer_ldu, &l.counts), (BRICK, &alone.counts));
 }
 
 #[test]
