@@ -29,6 +29,7 @@ pub fn all() -> Vec<Shape> {
         box_shape(),
         staircase(),
         house(),
+        barn(),
         mug(),
         arch(),
         floating(),
@@ -75,6 +76,20 @@ fn house() -> Shape {
         file: "house.obj",
         mesh,
         expected: vec![((24.0 + 9.0) * 8.0, EXACT)],
+    }
+}
+
+/// A long barn: walls 8 wide (x), 3 high, 12 deep (z), under a shallow gable
+/// roof rising 2.5 to a ridge along z (about 32 degrees, the pitch of a 33
+/// degree slope).
+fn barn() -> Shape {
+    let profile = [[0.0, 0.0], [8.0, 0.0], [8.0, 3.0], [4.0, 5.5], [0.0, 3.0]];
+    let mut mesh = Mesh::default();
+    mesh.extrude(&profile, 0.0, 12.0);
+    Shape {
+        file: "barn.obj",
+        mesh,
+        expected: vec![((24.0 + 10.0) * 12.0, EXACT)],
     }
 }
 
