@@ -183,6 +183,7 @@ fixtures_build! {
     builds_box: "box.obj",
     builds_staircase: "staircase.obj",
     builds_house: "house.obj",
+    builds_barn: "barn.obj",
     builds_mug: "mug.obj",
     builds_arch: "arch.obj",
     builds_floating: "floating.obj",

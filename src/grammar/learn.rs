@@ -541,8 +541,8 @@ impl Learned {
             h,
             "{} read: {} of catalog parts, {} skipped (not in the catalog).",
             plural(r.pieces, "piece"),
-            r.learned_pieces,
-            r.pieces - r.learned_pieces
+            thousands(r.learned_pieces as u64),
+            thousands((r.pieces - r.learned_pieces) as u64)
         );
         let _ = writeln!(h, "{}.", self.totals());
         h.push_str(
@@ -582,8 +582,8 @@ impl Learned {
             plural(r.builds.len(), "build"),
             plural(r.submodel_builds, "separately built submodel"),
             plural(r.pieces, "piece"),
-            r.learned_pieces,
-            r.pieces - r.learned_pieces
+            thousands(r.learned_pieces as u64),
+            thousands((r.pieces - r.learned_pieces) as u64)
         );
         if !r.skipped.is_empty() {
             s.push_str("  skipped, not in the catalog:\n");

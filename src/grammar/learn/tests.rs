@@ -767,6 +767,19 @@ fn summary_sets_the_totals_beside_the_papers() {
         s.contains("  counts                2 to 2    1 to 139\n"),
         "{s}"
     );
+    // Every count in thousands: 1,001 1x1s in a row, none on another.
+    let row: Vec<Placement> = (0..1001).map(|x| pl("3005", x, 0, 0, Rot::R0)).collect();
+    let l = learn_one(&build_text(&row));
+    let s = l.summary();
+    assert!(
+        s.contains(": 1,001 pieces, 1,001 of catalog parts, 0 skipped\n"),
+        "{s}"
+    );
+    let text = l.to_rules_text();
+    assert!(
+        text.contains("# 1,001 pieces read: 1,001 of catalog parts, 0 skipped"),
+        "{text}"
+    );
     assert_eq!(thousands(1_234_567), "1,234,567");
     assert_eq!(thousands(999), "999");
     let names: Vec<String> = (0..30).map(|i| format!("build-{i:02}.ldr")).collect();
