@@ -272,8 +272,12 @@ impl PartKind {
     /// slope's rows take some arithmetic, and the search asks often).
     pub fn body(self, rot: Rot, origin: Cell, layer_ldu: i32) -> Body {
         use std::sync::OnceLock;
-        static TABLES: [OnceLock<Vec<Option<Body>>>; CACHED_LAYERS.len()] =
-            [const { OnceLock::new() }; CACHED_LAYERS.len()];
+        static TABLES: [OnceLock<Vec<Option<Body>>>; 4] = [
+            OnceLock::new(),
+            OnceLock::new(),
+            OnceLock::new(),
+            OnceLock::new(),
+        ];
         let Some(k) = CACHED_LAYERS.iter().position(|&u| u == layer_ldu) else {
             return self.spec().body(rot, origin, layer_ldu);
         };
@@ -339,7 +343,6 @@ macro_rules! slope {
 /// Slopes give their width as `studs_x` and their depth (back row
 /// included) as `studs_y`: LDraw's "Slope Brick 45 2 x 4" (3037) is 4 wide
 /// and 2 deep.
-#[rustfmt::skip] // A data table: one part a line.
 pub static PARTS: &[PartSpec] = &[
     brick!("3005", "3005", "Brick 1 x 1", 1, 1, 0.44),
     brick!("3004", "3004", "Brick 1 x 2", 2, 1, 0.80),
@@ -363,14 +366,78 @@ pub static PARTS: &[PartSpec] = &[
     plate!("3020", "3020", "Plate 2 x 4", 4, 2, 0.97),
     plate!("3795", "3795", "Plate 2 x 6", 6, 2, 1.42),
     plate!("3034", "3034", "Plate 2 x 8", 8, 2, 1.88),
-    slope!("3040b", "3040", "Slope Brick 45 2 x 1", Shape::Slope, 1, 2, 0.67),
-    slope!("3039", "3039", "Slope Brick 45 2 x 2", Shape::Slope, 2, 2, 1.17),
-    slope!("3038", "3038", "Slope Brick 45 2 x 3", Shape::Slope, 3, 2, 1.66),
-    slope!("3037", "3037", "Slope Brick 45 2 x 4", Shape::Slope, 4, 2, 2.15),
-    slope!("4286", "4286", "Slope Brick 33 3 x 1", Shape::Slope, 1, 3, 0.85),
-    slope!("3298", "3298", "Slope Brick 33 3 x 2", Shape::Slope, 2, 3, 1.53),
-    slope!("3665a", "3665", "Slope Brick 45 2 x 1 Inverted", Shape::Inverted, 1, 2, 0.68),
-    slope!("3660a", "3660", "Slope Brick 45 2 x 2 Inverted", Shape::Inverted, 2, 2, 1.18),
+    slope!(
+        "3040b",
+        "3040",
+        "Slope Brick 45 2 x 1",
+        Shape::Slope,
+        1,
+        2,
+        0.67
+    ),
+    slope!(
+        "3039",
+        "3039",
+        "Slope Brick 45 2 x 2",
+        Shape::Slope,
+        2,
+        2,
+        1.17
+    ),
+    slope!(
+        "3038",
+        "3038",
+        "Slope Brick 45 2 x 3",
+        Shape::Slope,
+        3,
+        2,
+        1.66
+    ),
+    slope!(
+        "3037",
+        "3037",
+        "Slope Brick 45 2 x 4",
+        Shape::Slope,
+        4,
+        2,
+        2.15
+    ),
+    slope!(
+        "4286",
+        "4286",
+        "Slope Brick 33 3 x 1",
+        Shape::Slope,
+        1,
+        3,
+        0.85
+    ),
+    slope!(
+        "3298",
+        "3298",
+        "Slope Brick 33 3 x 2",
+        Shape::Slope,
+        2,
+        3,
+        1.53
+    ),
+    slope!(
+        "3665a",
+        "3665",
+        "Slope Brick 45 2 x 1 Inverted",
+        Shape::Inverted,
+        1,
+        2,
+        0.68
+    ),
+    slope!(
+        "3660a",
+        "3660",
+        "Slope Brick 45 2 x 2 Inverted",
+        Shape::Inverted,
+        2,
+        2,
+        1.18
+    ),
 ];
 
 /// An LDraw colour code.

@@ -180,8 +180,9 @@ fn run_build(a: BuildArgs) -> Result<()> {
     if !a.quiet {
         let r = &out.report;
         println!(
-            "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks, verified",
-            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1], r.grid[2]
+            "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks high, verified",
+            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1],
+            fmt_bricks(r.grid[2], r.layer_ldu)
         );
         for p in &r.parts {
             println!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
@@ -199,6 +200,12 @@ fn run_build(a: BuildArgs) -> Result<()> {
                 rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.dropped_unbuildable
             );
         }
+        println!(
+            "  seams: {} of {} vertical seams continue into the course above ({:.0}%; lower is stronger)",
+            r.seams.continued,
+            r.seams.seams,
+            100.0 * r.seams.fraction
+        );
         let s = &r.seconds;
         println!(
             "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, write {:.2}s",
@@ -206,6 +213,16 @@ fn run_build(a: BuildArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// A height of `layers` layers `layer_ldu` high, in bricks (24 LDU).
+fn fmt_bricks(layers: i32, layer_ldu: i32) -> String {
+    let ldu = layers * layer_ldu;
+    if ldu % 24 == 0 {
+        (ldu / 24).to_string()
+    } else {
+        format!("{:.2}", f64::from(ldu) / 24.0)
+    }
 }
 
 fn run_verify(file: PathBuf) -> Result<bool> {

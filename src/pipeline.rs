@@ -149,6 +149,9 @@ pub struct BuildReport {
     pub triangles: usize,
     /// Grid size in studs (x, y) and layers (z).
     pub grid: [i32; 3],
+    /// Height of a layer in LDU: 24 (a brick), 12 (with slopes), 8 (with
+    /// plates).
+    pub layer_ldu: i32,
     /// Voxels of the input after voxelization.
     pub voxels_input: usize,
     /// Voxels built (after repairs).
@@ -157,6 +160,8 @@ pub struct BuildReport {
     pub pieces: usize,
     /// Mean voxels per piece.
     pub voxels_per_piece: f64,
+    /// Vertical seams and how many continue into the course above.
+    pub seams: crate::assembly::metrics::SeamStats,
     /// Pieces by part.
     pub parts: Vec<PartCount>,
     /// Connected components of the finished build (1 when verified).
@@ -190,6 +195,10 @@ pub struct ReportOptions {
     pub seed: u64,
     /// Search budget, seconds.
     pub time_budget: f64,
+    /// Whether slopes were allowed.
+    pub slopes: bool,
+    /// Whether plates were allowed.
+    pub plates: bool,
 }
 
 /// Stage callbacks, for progress display.
@@ -361,13 +370,17 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             steps: step_name(opts.steps),
             seed: opts.search.seed,
             time_budget: opts.search.time_budget.as_secs_f64(),
+            slopes: opts.slopes,
+            plates: opts.plates,
         },
         triangles: mesh.triangles.len(),
         grid: [nx, ny, nz],
+        layer_ldu: rules.layer_ldu(),
         voxels_input: model.grid.count(),
         voxels,
         pieces,
         voxels_per_piece: ((voxels as f64 / pieces.max(1) as f64) * 100.0).round() / 100.0,
+        seams: crate::assembly::metrics::seams(&assembly),
         parts: parts.into_values().collect(),
         components: 1,
         steps: assembly.step_count(),

@@ -192,6 +192,76 @@ fixtures_build! {
     builds_wedge: "wedge.stl",
 }
 
+/// The `1` lines of an LDraw file whose part is one of `ids`.
+fn count_parts(ldr: &str, ids: &[&str]) -> usize {
+    ldr.lines()
+        .filter(|l| l.starts_with("1 "))
+        .filter(|l| {
+            let part = l.split_whitespace().last().unwrap_or("");
+            ids.iter().any(|id| part == format!("{id}.dat"))
+        })
+        .count()
+}
+
+const SLOPES: [&str; 8] = [
+    "3040b", "3039", "3038", "3037", "4286", "3298", "3665a", "3660a",
+];
+const PLATES: [&str; 6] = ["3024", "3023b", "3623", "3710", "3022", "3020"];
+
+/// Builds `fixture` with `extra` options, verifies the result with the
+/// `verify` command, and returns the `.ldr` text and the report.
+fn build_verified(fixture_name: &str, extra: &[&str]) -> (String, Value) {
+    let tmp = tempdir();
+    let out = tmp.path().join("out");
+    build(tmp.path(), &fixture(fixture_name), &out, extra).assert_ok();
+    let stem = Path::new(fixture_name)
+        .file_stem()
+        .unwrap()
+        .to_str()
+        .unwrap();
+    let ldr = out.join(format!("{stem}.ldr"));
+    let check = run_in(tmp.path(), &["verify", s(&ldr)]);
+    check.assert_ok();
+    (std::fs::read_to_string(&ldr).unwrap(), read_report(&out))
+}
+
+#[test]
+fn slopes_are_placed_where_roofs_slant() {
+    for name in ["barn.obj", "house.obj"] {
+        let (plain, _) = build_verified(name, &[]);
+        assert_eq!(count_parts(&plain, &SLOPES), 0, "no slopes unless asked");
+        let (ldr, report) = build_verified(name, &["--slopes"]);
+        let slopes = count_parts(&ldr, &SLOPES);
+        assert!(slopes >= 4, "{name}: only {slopes} slopes:\n{ldr}");
+        // Half-brick layers: a brick course is two of them.
+        assert_eq!(report["options"]["slopes"], true);
+        assert_eq!(report_u64(&report, "layer_ldu"), 12);
+        // Every slope sits with its studded back row toward the ridge: its
+        // face looks outward, so nothing stands on its sloping face (the
+        // verifier would report an overlap) and the top course holds.
+        assert_eq!(report_u64(&report, "components"), 1);
+    }
+}
+
+#[test]
+fn plates_follow_the_shape_more_closely() {
+    let (ldr, report) = build_verified("house.obj", &["--plates"]);
+    let plates = count_parts(&ldr, &PLATES);
+    assert!(plates > 0, "no plates:\n{ldr}");
+    assert_eq!(report_u64(&report, "components"), 1);
+    assert_eq!(report_u64(&report, "layer_ldu"), 8);
+    // Plate layers are 8 LDU: some piece sits off the brick grid.
+    let off_brick = ldr
+        .lines()
+        .filter(|l| l.starts_with("1 "))
+        .filter_map(|l| l.split_whitespace().nth(3)?.parse::<i64>().ok())
+        .any(|y| y % 24 != 0);
+    assert!(
+        off_brick,
+        "every piece on brick layers: plates were not used"
+    );
+}
+
 #[test]
 fn every_fixture_has_a_build_test() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");

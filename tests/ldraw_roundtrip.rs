@@ -46,13 +46,34 @@ fn every_part_in_every_rotation_round_trips() {
                 Placement::new(kind, Cell::new(3, 5, 2), rot),
                 Placement::new(kind, Cell::new(1, 0, 7), rot.then(Rot::R90)),
             ];
-            // Layers as high as to_assembly picks them: a brick, or a
-            // plate for plates.
-            let layer_ldu = kind.spec().height_ldu();
-            let asm = Assembly::from_order(&order, layer_ldu, Color(71));
+            let asm = Assembly::from_order(&order, 8, Color(71));
             assert_eq!(round_trip(&asm), asm, "{kind} {rot:?}");
         }
     }
+}
+
+/// Slopes on half-brick layers: their LDraw origin is on the back row, and
+/// the reader picks 12 LDU layers back.
+#[test]
+fn slopes_on_half_brick_layers_round_trip() {
+    let order = [
+        Placement::new(part("3001"), Cell::new(0, 0, 0), Rot::R0),
+        Placement::new(part("3039"), Cell::new(0, 0, 2), Rot::R90),
+        Placement::new(part("3298"), Cell::new(2, 0, 2), Rot::R180),
+        Placement::new(part("3004"), Cell::new(0, 0, 1), Rot::R270),
+        Placement::new(part("3665a"), Cell::new(5, 1, 3), Rot::R270),
+    ];
+    let asm = Assembly::from_order(&order, 12, Color(4));
+    let back = round_trip(&asm);
+    assert_eq!(back, asm);
+    assert_eq!(back.layer_ldu, 12);
+    // 3039 turned a quarter: the back row (LDraw +Z turned) lies at grid -x,
+    // so the origin sits 10 LDU from the footprint's centre toward -X.
+    let text = write(&asm);
+    assert!(
+        text.contains("1 4 10 -48 20 0 0 -1 0 1 0 1 0 0 3039.dat"),
+        "{text}"
+    );
 }
 
 #[test]

@@ -4,6 +4,7 @@
 //! booklet back ends trust. It is produced by the search and checked by the
 //! independent [`verify`] module before anything is written.
 
+pub mod metrics;
 pub mod verify;
 
 use serde::Serialize;
@@ -97,18 +98,21 @@ impl Assembly {
         let mut step = 0u32;
         let mut in_step = 0usize;
         let mut last_z = i32::MIN;
+        // Layers by brick course (24 LDU), whatever the grid's layer height.
+        let layer_ldu = self.layer_ldu;
+        let course = |p: &Placed| p.placement.origin.z * layer_ldu / 24;
         for p in &mut self.pieces {
             let new_step = match grouping {
                 StepGrouping::Each | StepGrouping::Auto => true,
                 StepGrouping::Size(n) => in_step >= n.max(1),
-                StepGrouping::Layer => p.placement.origin.z != last_z,
+                StepGrouping::Layer => course(p) != last_z,
             };
             if new_step || step == 0 {
                 step += 1;
                 in_step = 0;
             }
             in_step += 1;
-            last_z = p.placement.origin.z;
+            last_z = course(p);
             p.step = Step(step);
         }
     }

@@ -435,6 +435,77 @@ mod tests {
 
     use Rot::{R0, R90};
 
+    /// An assembly of any parts on layers `layer_ldu` high.
+    fn build_in(layer_ldu: i32, pieces: &[(&str, i32, i32, i32, Rot)]) -> Assembly {
+        let mut asm = build(pieces);
+        asm.layer_ldu = layer_ldu;
+        asm
+    }
+
+    fn not_connected(asm: &Assembly) -> Vec<usize> {
+        verify(asm, None)
+            .failures
+            .iter()
+            .filter_map(|f| match f {
+                Failure::NotConnected { piece, .. } => Some(*piece),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn slopes_take_studs_on_their_back_row_only() {
+        // A 2x2 slope on a 2x4 (half-brick layers: a brick is two), its
+        // back row at y = 1.
+        let base = ("3001", 0, 0, 0, R0);
+        let slope = ("3039", 0, 0, 2, R0);
+        // A 1x2 across the back row holds; one on the front row does not,
+        // since the front row has no studs (and its face must stay clear).
+        let on_back = build_in(12, &[base, slope, ("3004", 0, 1, 4, R0)]);
+        assert!(verify(&on_back, None).is_ok(), "{}", verify(&on_back, None));
+        let on_front = build_in(12, &[base, slope, ("3004", 0, 0, 3, R0)]);
+        let report = verify(&on_front, None);
+        assert!(!report.is_ok());
+        // The 1x2 on the front row sits on the slope's lower layer: it
+        // overlaps the sloping face's cell.
+        assert!(report
+            .failures
+            .iter()
+            .any(|f| matches!(f, Failure::Overlap { .. })));
+        // An inverted slope connects below only under its back row: a
+        // 1x2 under its front row is not held.
+        let inv = ("3660a", 0, 0, 4, R0);
+        let under_back = build_in(12, &[base, ("3003", 0, 0, 2, R0), inv]);
+        assert!(verify(&under_back, None).is_ok());
+        let front_only = build_in(
+            12,
+            &[
+                ("3004", 0, 0, 0, R0),
+                ("3004", 0, 0, 2, R0),
+                ("3660a", 0, 0, 4, R0),
+            ],
+        );
+        assert_eq!(not_connected(&front_only), vec![2]);
+    }
+
+    #[test]
+    fn plates_connect_on_plate_layers() {
+        // A 2x4 brick is three plate layers; a plate on it, a brick on the
+        // plate.
+        let asm = build_in(
+            8,
+            &[
+                ("3001", 0, 0, 0, R0),
+                ("3020", 2, 0, 3, R0),
+                ("3001", 4, 0, 4, R0),
+            ],
+        );
+        assert!(verify(&asm, None).is_ok(), "{}", verify(&asm, None));
+        // A plate floating one layer above is connected to nothing.
+        let gap = build_in(8, &[("3001", 0, 0, 0, R0), ("3020", 0, 0, 4, R0)]);
+        assert_eq!(not_connected(&gap), vec![1]);
+    }
+
     #[test]
     fn staggered_two_layer_wall_in_a_valid_order_passes_with_its_cover() {
         // Layer 0: 1x4 at x 0..3 and 4..7; layer 1: 1x2, 1x4 across the

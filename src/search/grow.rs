@@ -13,6 +13,7 @@
 //! piece must cover, so the build grows outward and stays connected by
 //! construction. The result is handed on as the equivalent backward trace.
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use rand::Rng;
@@ -22,6 +23,7 @@ use super::dfs::PartResult;
 use super::state::{Anchor, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
+use crate::catalog::PartKind;
 use crate::geom::{Body, Cell, CellBox, Rot};
 use crate::grammar::RuleSet;
 use crate::voxel::VoxelGrid;
@@ -40,6 +42,10 @@ struct Frame {
     /// Whether the look-ahead was switched off after every rule failed.
     relaxed: bool,
     placed: bool,
+    /// For each new piece's shape tried so far, the placements over the
+    /// target that fit the free voxels and can be pressed in: many rules
+    /// share a shape, and the fit does not change while the frame lives.
+    fits: HashMap<(PartKind, Rot), Vec<Placement>>,
 }
 
 /// Grows a build of `v` forward: from a starting piece near the middle of
@@ -127,6 +133,16 @@ pub(crate) fn grow(
         by_shape.extend((0..starts.len() as u32).map(|k| n_rules + k));
     }
     let shapes = super::footprints(rules);
+    let pieces: Vec<(PartKind, Rot)> = rules
+        .alphabet()
+        .iter()
+        .flat_map(|&p| {
+            Rot::ALL
+                .into_iter()
+                .filter(move |&r| p.spec().canonical_rot(r) == r)
+                .map(move |r| (p, r))
+        })
+        .collect();
     let mut stack: Vec<Frame> = Vec::new();
     loop {
         let left = v.count() - cover.count();
@@ -157,6 +173,7 @@ pub(crate) fn grow(
                 widened: false,
                 relaxed: false,
                 placed: false,
+                fits: HashMap::new(),
             });
         }
         let at_root = stack.len() == 1;
@@ -172,23 +189,42 @@ pub(crate) fn grow(
                     starts[(si - n_rules) as usize]
                 };
                 // Every way the piece can lie over the target voxel.
-                let local = added.body(added_rot, Cell::new(0, 0, 0), u);
-                let corners = local.volume() as usize;
-                while f.corner < corners {
-                    let o = local.cells().nth(f.corner).expect("a cell of the body");
+                let target = f.target;
+                let fit = f
+                    .fits
+                    .entry((added, added_rot))
+                    .or_insert_with(|| {
+                        let local = added.body(added_rot, Cell::new(0, 0, 0), u);
+                        local
+                            .cells()
+                            .map(|o| {
+                                Placement::new(added, target.offset(-o.x, -o.y, -o.z), added_rot)
+                            })
+                            .filter(|p| {
+                                let b = p.body(u);
+                                if !v.all_set_body(&b)
+                                    || cover.any_set_body(&b)
+                                    || !face_clear(solid, built, &b)
+                                {
+                                    return false;
+                                }
+                                let ok = super::state::placeable(&cover, built, &b.bbox);
+                                if !ok {
+                                    stats.rejected_placeable += 1;
+                                }
+                                ok
+                            })
+                            .collect()
+                    })
+                    .clone();
+                while f.corner < fit.len() {
+                    let p = fit[f.corner];
                     f.corner += 1;
                     stats.match_tries += 1;
                     if stats.match_tries % 65_536 == 0 && Instant::now() >= deadline {
                         return PartResult::OutOfBudget;
                     }
-                    let p = Placement::new(added, f.target.offset(-o.x, -o.y, -o.z), added_rot);
                     let b = p.body(u);
-                    if !v.all_set_body(&b)
-                        || cover.any_set_body(&b)
-                        || !face_clear(solid, built, &b)
-                    {
-                        continue;
-                    }
                     let anchor = if si < n_rules {
                         let x = &rules.variants()[si as usize];
                         let (dx, dy, dz) = x.offset;
@@ -209,10 +245,6 @@ pub(crate) fn grow(
                         }
                         Anchor::Built
                     };
-                    if !super::state::placeable(&cover, built, &b.bbox) {
-                        stats.rejected_placeable += 1;
-                        continue;
-                    }
                     cover.set_body(&b, true);
                     let ok = f.relaxed || still_coverable(v, &cover, built, &b.bbox, &shapes);
                     cover.set_body(&b, false);
@@ -280,7 +312,7 @@ pub(crate) fn grow(
                     }
                     continue;
                 }
-                let hopeless = !can_ever_cover(v, built, f.target, &shapes);
+                let hopeless = !can_ever_cover(v, built, solid, u, f.target, &pieces);
                 if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
@@ -319,9 +351,24 @@ pub(crate) fn grow(
 /// Whether some piece over `u` fits the part's voxels and has a voxel of the
 /// part or of the built structure directly above or below: if not, no order
 /// of building can ever join `u`.
-fn can_ever_cover(v: &VoxelGrid, built: &VoxelGrid, u: Cell, shapes: &[(i32, i32)]) -> bool {
-    CellBox::covering(u, shapes)
-        .any(|bx| v.all_set(&bx) && (State::touches(v, &bx) || State::touches(built, &bx)))
+fn can_ever_cover(
+    v: &VoxelGrid,
+    built: &VoxelGrid,
+    solid: &VoxelGrid,
+    layer_ldu: i32,
+    u: Cell,
+    pieces: &[(PartKind, Rot)],
+) -> bool {
+    pieces.iter().any(|&(part, rot)| {
+        let local = part.body(rot, Cell::new(0, 0, 0), layer_ldu);
+        let fits = local.cells().any(|o| {
+            let b = local.moved(u.x - o.x, u.y - o.y, u.z - o.z);
+            v.all_set_body(&b)
+                && face_clear(solid, built, &b)
+                && (State::links(v, &b) || State::links(built, &b))
+        });
+        fits
+    })
 }
 
 /// The biggest starting piece that covers `seed` with its bottom layer and
