@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use brickwright::assembly::verify::verify;
 use brickwright::assembly::StepGrouping;
+use brickwright::grammar::learn::learn;
 use brickwright::grammar::{extended_alphabet, rules_text, DEFAULT_ALPHABET};
 use brickwright::pipeline::{self, BuildOptions, Progress, Silent};
 use brickwright::voxel::{Sizing, Up};
@@ -40,6 +41,21 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Learn rule weights from step-ordered LDraw builds (.ldr/.mpd) and write a rule file.
+    Learn(LearnArgs),
+}
+
+#[derive(Args)]
+struct LearnArgs {
+    /// The builds: .ldr or .mpd files, or directories of them.
+    #[arg(required = true)]
+    builds: Vec<PathBuf>,
+    /// Where to write the rule file; `-` or none for standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Print nothing but errors (and the rule file, to standard output).
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -241,12 +257,32 @@ fn run_rules(alphabet: Alphabet, output: Option<PathBuf>) -> Result<()> {
     Ok(())
 }
 
+fn run_learn(a: LearnArgs) -> Result<()> {
+    let learned = learn(&a.builds)?;
+    let text = learned.to_rules_text();
+    let file = a.output.filter(|p| p.as_os_str() != "-");
+    match &file {
+        Some(p) => brickwright::fsutil::write_atomic(p, |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("{}: cannot write", p.display()))?,
+        None => print!("{text}"),
+    }
+    if !a.quiet {
+        // The summary goes beside the rule file, never into it.
+        match &file {
+            Some(p) => println!("{}  wrote {}", learned.summary(), p.display()),
+            None => eprint!("{}", learned.summary()),
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Build(a) => run_build(a).map(|()| true),
         Command::Verify { file } => run_verify(file),
         Command::Rules { alphabet, output } => run_rules(alphabet, output).map(|()| true),
+        Command::Learn(a) => run_learn(a).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -576,3 +576,153 @@ fn the_shipped_rule_files_load() {
         .assert_ok();
     }
 }
+
+/// A two-brick build with a separately built submodel (a 1x2 on a 1x2,
+/// attached to the base) and a tile the catalog does not know.
+const LEARN_MPD: &str = "\
+0 FILE main.ldr
+1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat
+0 STEP
+1 4 60 -48 20 1 0 0 0 1 0 0 0 1 3001.dat
+0 STEP
+1 4 0 -48 0 1 0 0 0 1 0 0 0 1 post.ldr
+1 15 40 -80 20 1 0 0 0 1 0 0 0 1 87079.dat
+0 STEP
+0 NOFILE
+0 FILE post.ldr
+1 16 20 -24 10 1 0 0 0 1 0 0 0 1 3004.dat
+1 16 20 -48 10 1 0 0 0 1 0 0 0 1 3004.dat
+0 NOFILE
+";
+
+#[test]
+fn learned_rules_drive_a_build() {
+    let tmp = tempdir();
+    // Example data: a build brickwright made, and a hand-written MPD.
+    let made = tmp.path().join("made");
+    build(tmp.path(), &fixture("house.obj"), &made, &[]).assert_ok();
+    let builds = tmp.path().join("builds");
+    std::fs::create_dir(&builds).unwrap();
+    std::fs::rename(made.join("house.ldr"), builds.join("house.ldr")).unwrap();
+    std::fs::write(builds.join("post.mpd"), LEARN_MPD).unwrap();
+
+    let rules = tmp.path().join("learned.rules");
+    let run = run_in(tmp.path(), &["learn", s(&builds), "-o", s(&rules)]);
+    run.assert_ok();
+    for want in [
+        "read 2 builds (1 separately built submodel)",
+        "1 x 87079",
+        "post.mpd:7",
+        "distinct rules",
+        "2,484",
+        "1 to 139",
+        "wrote ",
+    ] {
+        assert!(run.stdout.contains(want), "{want:?}\n{}", run.describe());
+    }
+    assert_eq!(run.stderr, "", "{}", run.describe());
+    let text = std::fs::read_to_string(&rules).unwrap();
+    assert!(
+        text.contains("\n#   house.ldr, post.mpd\n"),
+        "the header names the builds:\n{text}"
+    );
+    assert!(text.contains("\nrule "), "{text}");
+
+    // The same files named in another order, to standard output: the same
+    // bytes, with the summary on standard error.
+    let mpd = builds.join("post.mpd");
+    let house = builds.join("house.ldr");
+    for args in [
+        vec!["learn", s(&mpd), s(&house)],
+        vec!["learn", s(&mpd), s(&house), "-o", "-"],
+    ] {
+        let out = run_in(tmp.path(), &args);
+        out.assert_ok();
+        assert!(out.stdout == text, "{args:?}: stdout differs from the file");
+        assert!(out.stderr.contains("distinct rules"), "{}", out.describe());
+    }
+    let quiet = run_in(tmp.path(), &["learn", s(&builds), "-q", "-o", s(&rules)]);
+    quiet.assert_ok();
+    assert_eq!((quiet.stdout.as_str(), quiet.stderr.as_str()), ("", ""));
+    assert_eq!(std::fs::read_to_string(&rules).unwrap(), text);
+
+    let out = tmp.path().join("out");
+    build(
+        tmp.path(),
+        &fixture("box.obj"),
+        &out,
+        &["--rules", s(&rules)],
+    )
+    .assert_ok();
+    let check = run_in(tmp.path(), &["verify", s(&out.join("box.ldr"))]);
+    check.assert_ok();
+}
+
+#[test]
+fn learn_rejects_bad_builds_with_one_line() {
+    let good = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n";
+    let cases = [
+        (
+            "garbage.ldr",
+            format!("{good}garbage here\n"),
+            "garbage.ldr:2: not LDraw text",
+        ),
+        (
+            "offgrid.ldr",
+            format!("{good}0 STEP\n1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
+            "offgrid.ldr:3: part `3001.dat` is off the grid",
+        ),
+        (
+            "tilted.ldr",
+            format!("{good}1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n"),
+            "tilted.ldr:2: part `3001.dat` is not turned by a quarter turn",
+        ),
+        (
+            "empty.ldr",
+            "0 nothing here\n0 STEP\n".to_string(),
+            "empty.ldr: nothing to learn from",
+        ),
+        (
+            "tiles.ldr",
+            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n".to_string(),
+            "empty.ldr: nothing to learn from",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let tmp = tempdir();
+        let path = tmp.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let ok = tmp.path().join("ok.ldr");
+        std::fs::write(&ok, good).unwrap();
+        let want = want.replace("empty.ldr", name);
+        let out = tmp.path().join("learned.rules");
+        // Alone, and after a good build: the bad one still fails the run.
+        for args in [
+            vec!["learn", s(&path), "-o", s(&out)],
+            vec!["learn", s(&ok), s(&path), "-o", s(&out)],
+        ] {
+            let run = run_in(tmp.path(), &args);
+            run.assert_clean_error();
+            assert!(run.stderr.contains(&want), "{want}\n{}", run.describe());
+            assert!(!out.exists(), "a failed learn must write nothing");
+        }
+    }
+    let tmp = tempdir();
+    let run = run_in(tmp.path(), &["learn", "missing.ldr"]);
+    run.assert_clean_error();
+    assert!(
+        run.stderr.contains("missing.ldr: cannot read the file"),
+        "{}",
+        run.describe()
+    );
+    let run = run_in(tmp.path(), &["learn", "."]);
+    run.assert_clean_error();
+    assert!(
+        run.stderr.contains("no .ldr or .mpd files"),
+        "{}",
+        run.describe()
+    );
+    // No builds at all is a usage error.
+    let run = run_in(tmp.path(), &["learn"]);
+    assert_eq!(run.code, Some(2), "{}", run.describe());
+}

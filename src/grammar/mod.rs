@@ -28,6 +28,7 @@
 //! ```
 
 mod defaults;
+pub mod learn;
 mod parse;
 
 pub use defaults::{default_rules_text, extended_alphabet, rules_text, DEFAULT_ALPHABET};

@@ -92,7 +92,9 @@ use crate::assembly::Placement;
 use crate::catalog::{PartKind, Shape};
 use crate::geom::Rot;
 
-pub use read::{parse_ldr, read_ldr, to_assembly, LdrModel, PartRef};
+pub use read::{
+    layer_ldu_of, parse_ldr, read_ldr, to_assembly, to_placement, Instance, LdrModel, PartRef,
+};
 pub use write::{write_ldr, LdrMeta};
 
 #[cfg(doc)]

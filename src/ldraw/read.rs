@@ -8,11 +8,15 @@
 //!    references to sections of the same file with their transforms composed
 //!    and colour 16 ("the parent's colour") resolved. The result is an
 //!    [`LdrModel`]: a flat list of part references in file order, each with
-//!    its step and the line it came from. Any part name is accepted here.
+//!    its step, the line it came from and the submodel [`Instance`] it
+//!    belongs to (so a caller can tell separately built submodels apart).
+//!    Any part name is accepted here.
 //! 2. [`to_assembly`] maps each reference to a catalog part, a quarter-turn
 //!    [`Rot`] and a grid cell, the inverse of [`super::write_ldr`], and
 //!    rejects what does not fit: unknown parts, tilted parts, positions off
-//!    the stud grid.
+//!    the stud grid. [`to_placement`] does the same for one reference,
+//!    without the shift and with the piece's bottom in LDU (`brickwright
+//!    learn` maps its builds with it).
 //!
 //! Every error names `file:line`; garbage input gives an error, never a
 //! panic.
@@ -64,6 +68,23 @@ pub struct PartRef {
     pub part: String,
     /// 1-based line of the type-1 line that names the part.
     pub line: usize,
+    /// The submodel instance the reference belongs to directly: an index
+    /// into [`LdrModel::instances`], 0 for the main model.
+    pub instance: usize,
+}
+
+/// One expansion of a model: the main model, or one reference to a
+/// submodel (two references to the same submodel are two instances).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Instance {
+    /// The instance whose model references this one; `None` for the main
+    /// model.
+    pub parent: Option<usize>,
+    /// The submodel's name as the reference writes it (empty for the main
+    /// model).
+    pub name: String,
+    /// 1-based line of the reference (0 for the main model).
+    pub line: usize,
 }
 
 /// A parsed and flattened LDraw model.
@@ -73,6 +94,9 @@ pub struct LdrModel {
     pub path: PathBuf,
     /// Part references in file order, submodels expanded in place.
     pub parts: Vec<PartRef>,
+    /// Every model instance, in the order they were expanded: the main
+    /// model first, then each submodel reference depth first.
+    pub instances: Vec<Instance>,
 }
 
 /// Reads and parses the LDraw (`.ldr` or `.mpd`) file at `path`.
@@ -95,10 +119,16 @@ pub fn read_ldr(path: &Path) -> Result<LdrModel, LdrError> {
 pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
     let file = parse_sections(text, path)?;
     let mut parts = Vec::new();
+    let mut instances = vec![Instance {
+        parent: None,
+        name: String::new(),
+        line: 0,
+    }];
     let mut flat = Flattener {
         file: &file,
         path,
         out: &mut parts,
+        instances: &mut instances,
         expanded: 0,
         stack: vec![file.main],
     };
@@ -106,12 +136,13 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
     for cmd in &file.sections[file.main].cmds {
         match cmd {
             Cmd::Step => step += 1,
-            Cmd::Ref(r) => flat.expand(r, &Xform::IDENTITY, INHERIT_COLOUR, step)?,
+            Cmd::Ref(r) => flat.expand(r, &Xform::IDENTITY, INHERIT_COLOUR, step, 0)?,
         }
     }
     Ok(LdrModel {
         path: path.to_path_buf(),
         parts,
+        instances,
     })
 }
 
@@ -129,9 +160,7 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
         raw.push((to_placement(r, &model.path)?, r.step, r.color));
     }
     let low = raw.iter().map(|(p, _, _)| p.origin.z).min().unwrap_or(0);
-    let layer_ldu = raw.iter().fold(24, |g, (p, _, _)| {
-        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
-    });
+    let layer_ldu = layer_ldu_of(raw.iter().map(|(p, _, _)| p));
     for (p, _, _) in &mut raw {
         // The reader leaves the bottom in LDU; make it a layer index.
         p.origin.z = (p.origin.z - low) / layer_ldu;
@@ -163,6 +192,18 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
     Ok(Assembly { pieces, layer_ldu })
 }
 
+/// The height in LDU of the layers that `pieces`, as [`to_placement`] gives
+/// them (`z` the bottom in LDU), fit on: the largest that divides a brick
+/// (24 LDU), every piece's height and every bottom's height above the
+/// lowest. A brick for bricks on brick courses, 12 or 4 LDU for bricks half
+/// a brick apart, 8 once plates appear; 24 for no pieces.
+pub fn layer_ldu_of<'a>(pieces: impl Iterator<Item = &'a Placement> + Clone) -> i32 {
+    let low = pieces.clone().map(|p| p.origin.z).min().unwrap_or(0);
+    pieces.fold(24, |g, p| {
+        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
+    })
+}
+
 fn gcd(a: i32, b: i32) -> i32 {
     if b == 0 {
         a.abs()
@@ -172,8 +213,18 @@ fn gcd(a: i32, b: i32) -> i32 {
 }
 
 /// One reference's catalog part, rotation and raw (unshifted) grid cell,
-/// with the height of its bottom above LDraw's `Y = 0`, in LDU, as `z`.
-fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
+/// with the height of its bottom above LDraw's `Y = 0`, in LDU, as `z`
+/// (a multiple of 4: pieces stand on a half-plate grid). `path` names the
+/// file in errors.
+///
+/// [`to_assembly`] turns `z` into a layer index once it knows the layer
+/// height of the whole model; `brickwright learn` does the same over all
+/// its builds.
+///
+/// Errors if the part is not in the catalog, is not turned by a quarter turn
+/// about the vertical axis, or does not sit on the stud grid and the
+/// half-plate grid.
+pub fn to_placement(r: &PartRef, path: &Path) -> Result<Placement, LdrError> {
     let kind = PartKind::from_id(&r.part).ok_or_else(|| LdrError::UnknownPart {
         path: path.to_path_buf(),
         line: r.line,
@@ -476,6 +527,8 @@ struct Flattener<'a> {
     file: &'a File,
     path: &'a Path,
     out: &'a mut Vec<PartRef>,
+    /// The model instances met so far; see [`LdrModel::instances`].
+    instances: &'a mut Vec<Instance>,
     /// References expanded so far, against [`MAX_EXPANDED`].
     expanded: usize,
     /// Sections being expanded, to catch a submodel that contains itself.
@@ -483,14 +536,15 @@ struct Flattener<'a> {
 }
 
 impl Flattener<'_> {
-    /// Expands `r`, found inside a model placed by `parent` in `color`, at
-    /// main-model step `step`.
+    /// Expands `r`, found inside model instance `instance` placed by
+    /// `parent` in `color`, at main-model step `step`.
     fn expand(
         &mut self,
         r: &RawRef,
         parent: &Xform,
         color: Color,
         step: usize,
+        instance: usize,
     ) -> Result<(), LdrError> {
         self.expanded += 1;
         if self.expanded > MAX_EXPANDED {
@@ -514,6 +568,7 @@ impl Flattener<'_> {
                 matrix: xf.m,
                 part: r.name.clone(),
                 line: r.line,
+                instance,
             });
             return Ok(());
         };
@@ -525,9 +580,15 @@ impl Flattener<'_> {
             });
         }
         self.stack.push(sub);
+        self.instances.push(Instance {
+            parent: Some(instance),
+            name: r.name.clone(),
+            line: r.line,
+        });
+        let me = self.instances.len() - 1;
         for cmd in &self.file.sections[sub].cmds {
             if let Cmd::Ref(child) = cmd {
-                self.expand(child, &xf, color, step)?;
+                self.expand(child, &xf, color, step, me)?;
             }
         }
         self.stack.pop();
@@ -577,6 +638,52 @@ mod tests {
             [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
         );
         assert_eq!(m.parts[2].pos, [100.0, -48.0, 0.0]);
+    }
+
+    #[test]
+    fn each_submodel_reference_is_a_new_instance() {
+        let text = "\
+0 FILE main.ldr
+1 4 0 -24 0 1 0 0 0 1 0 0 0 1 3001.dat
+1 4 0 -48 0 1 0 0 0 1 0 0 0 1 wall.ldr
+1 4 0 -96 0 1 0 0 0 1 0 0 0 1 wall.ldr
+0 FILE wall.ldr
+1 16 0 0 0 1 0 0 0 1 0 0 0 1 3004.dat
+1 16 0 0 0 1 0 0 0 1 0 0 0 1 post.ldr
+0 FILE post.ldr
+1 16 0 0 0 1 0 0 0 1 0 0 0 1 3005.dat
+";
+        let m = parse(text).unwrap();
+        let seen: Vec<(&str, usize)> = m
+            .parts
+            .iter()
+            .map(|p| (p.part.as_str(), p.instance))
+            .collect();
+        assert_eq!(
+            seen,
+            [
+                ("3001.dat", 0),
+                ("3004.dat", 1),
+                ("3005.dat", 2),
+                ("3004.dat", 3),
+                ("3005.dat", 4)
+            ]
+        );
+        let chain: Vec<(Option<usize>, &str, usize)> = m
+            .instances
+            .iter()
+            .map(|i| (i.parent, i.name.as_str(), i.line))
+            .collect();
+        assert_eq!(
+            chain,
+            [
+                (None, "", 0),
+                (Some(0), "wall.ldr", 3),
+                (Some(1), "post.ldr", 7),
+                (Some(0), "wall.ldr", 4),
+                (Some(3), "post.ldr", 7)
+            ]
+        );
     }
 
     #[test]

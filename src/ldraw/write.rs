@@ -109,7 +109,7 @@ mod tests {
             author: "me\r\n".into(),
             notes: vec!["a\nb".into()],
         };
-        let text = write(&Assembly::from_order(&[], 3, Color::RED), &meta);
+        let text = write(&Assembly::from_order(&[], 24, Color::RED), &meta);
         assert_eq!(
             text,
             "0 evil 1 4 0 0 0 1 0 0 0 1 0 0 0 1 3001.dat\n0 Name: x.ldr\n0 Author: me\n0 // a b\n"
