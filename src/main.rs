@@ -53,6 +53,10 @@ struct LearnArgs {
     /// Where to write the rule file; `-` or none for standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Weight of every connecting rule the builds never used (0: leave them out, so the
+    /// search can only use joints seen in the builds).
+    #[arg(long, default_value_t = brickwright::grammar::learn::DEFAULT_UNSEEN)]
+    unseen: f64,
     /// Print nothing but errors (and the rule file, to standard output).
     #[arg(short, long)]
     quiet: bool,
@@ -258,7 +262,10 @@ fn run_rules(alphabet: Alphabet, output: Option<PathBuf>) -> Result<()> {
 }
 
 fn run_learn(a: LearnArgs) -> Result<()> {
-    let learned = learn(&a.builds)?;
+    if !(a.unseen.is_finite() && a.unseen >= 0.0) {
+        anyhow::bail!("--unseen must be a weight of 0 or more");
+    }
+    let learned = learn(&a.builds)?.with_unseen((a.unseen > 0.0).then_some(a.unseen));
     let text = learned.to_rules_text();
     let file = a.output.filter(|p| p.as_os_str() != "-");
     match &file {

@@ -488,7 +488,18 @@ fn inverse(r: Rot) -> Rot {
     Rot::from_quarter_turns(4 - r.quarter_turns())
 }
 
+/// The weight `brickwright learn` gives rules no build used, below the
+/// lowest count (1): such rules stay possible but are rarely drawn.
+pub const DEFAULT_UNSEEN: f64 = 0.05;
+
 impl Learned {
+    /// These counts with every rule no build used allowed at weight `w`
+    /// (the rule file's `unseen` statement), or not at all for `None`.
+    pub fn with_unseen(mut self, w: Option<f64>) -> Learned {
+        self.rules = self.rules.with_unseen(w);
+        self
+    }
+
     /// The rule set of the counts: every part seen, a starting rule for
     /// each, the rules with their counts as weights.
     pub fn rule_set(&self) -> &RuleSet {
@@ -555,6 +566,13 @@ impl Learned {
              turned by ROT relative to A and its corner DX, DY studs from A's\n\
              (see rules/default.rules).",
         );
+        if let Some(w) = self.rules.unseen() {
+            let _ = write!(
+                h,
+                "\nRules no build used are allowed too, each as if seen {w} times\n\
+                 (`unseen`), so the search can still join any voxel a stud reaches."
+            );
+        }
         self.rules.to_text(&h)
     }
 

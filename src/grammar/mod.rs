@@ -120,7 +120,11 @@ pub struct Variant {
 pub struct RuleSet {
     alphabet: Vec<PartKind>,
     starts: Vec<StartRule>,
+    /// The basic rules: first the `explicit` ones the file gives, then the
+    /// unseen ones [`RuleSet::with_unseen`] adds.
     rules: Vec<Rule>,
+    explicit: usize,
+    unseen: Option<f64>,
     variants: Vec<Variant>,
     /// Where the rules came from, for reports.
     pub source: String,
@@ -151,10 +155,13 @@ impl RuleSet {
         rules: Vec<Rule>,
         source: String,
     ) -> Result<RuleSet, RuleError> {
+        let explicit = rules.len();
         let mut set = RuleSet {
             alphabet,
             starts,
             rules,
+            explicit,
+            unseen: None,
             variants: Vec::new(),
             source,
         };
@@ -182,12 +189,12 @@ impl RuleSet {
             });
         }
         let rules = self
-            .rules
+            .explicit_rules()
             .iter()
             .filter(|r| keep(r.anchor) && keep(r.added))
             .cloned()
             .collect();
-        RuleSet::new(alphabet, starts, rules, self.source.clone())
+        Ok(RuleSet::new(alphabet, starts, rules, self.source.clone())?.with_unseen(self.unseen))
     }
 
     /// The letters of Σ.
@@ -239,18 +246,8 @@ impl RuleSet {
                     ));
                 }
             }
-            let a = self.body(r.anchor, Rot::R0, Cell::new(0, 0, 0));
-            let dz = match r.dir {
-                Dir::Up => a.bbox.sz,
-                Dir::Down => -(r.added.spec().height_ldu() / self.layer_ldu()).max(1),
-            };
-            let b0 = self.body(r.added, r.added_rot, Cell::new(r.dx, r.dy, dz));
-            let connects = match r.dir {
-                Dir::Up => a.holds(&b0),
-                Dir::Down => b0.holds(&a),
-            };
-            if !connects {
-                return Err(RuleError::at(
+            let mine = self.rule_variants(RuleId(i as u32), r).ok_or_else(|| {
+                RuleError::at(
                     &self.source,
                     r.line,
                     format!(
@@ -265,33 +262,129 @@ impl RuleSet {
                         },
                         r.anchor
                     ),
-                ));
-            }
-            let mut mine: Vec<Variant> = Vec::new();
-            for turn in Rot::ALL {
-                let ra = a.turned(turn).bbox;
-                let rb = b0.turned(turn).bbox;
-                let v = Variant {
-                    rule: RuleId(i as u32),
-                    anchor: r.anchor,
-                    anchor_rot: r.anchor.spec().canonical_rot(turn),
-                    added: r.added,
-                    added_rot: r.added.spec().canonical_rot(r.added_rot.then(turn)),
-                    offset: (rb.min.x - ra.min.x, rb.min.y - ra.min.y, dz),
-                    dir: r.dir,
-                    weight: 0.0,
-                };
-                if !mine.iter().any(|m| same_geometry(m, &v)) {
-                    mine.push(v);
-                }
-            }
-            let n = mine.len() as f64;
-            for mut v in mine {
-                v.weight = r.weight / n;
-                out.push(v);
-            }
+                )
+            })?;
+            out.extend(mine);
         }
         Ok(out)
+    }
+
+    /// The distinct turns of rule `r` (numbered `id`), its weight shared
+    /// among them; `None` if its pieces do not stud-connect.
+    fn rule_variants(&self, id: RuleId, r: &Rule) -> Option<Vec<Variant>> {
+        let a = self.body(r.anchor, Rot::R0, Cell::new(0, 0, 0));
+        let dz = match r.dir {
+            Dir::Up => a.bbox.sz,
+            Dir::Down => -(r.added.spec().height_ldu() / self.layer_ldu()).max(1),
+        };
+        let b0 = self.body(r.added, r.added_rot, Cell::new(r.dx, r.dy, dz));
+        let connects = match r.dir {
+            Dir::Up => a.holds(&b0),
+            Dir::Down => b0.holds(&a),
+        };
+        if !connects {
+            return None;
+        }
+        let mut mine: Vec<Variant> = Vec::new();
+        for turn in Rot::ALL {
+            let ra = a.turned(turn).bbox;
+            let rb = b0.turned(turn).bbox;
+            let v = Variant {
+                rule: id,
+                anchor: r.anchor,
+                anchor_rot: r.anchor.spec().canonical_rot(turn),
+                added: r.added,
+                added_rot: r.added.spec().canonical_rot(r.added_rot.then(turn)),
+                offset: (rb.min.x - ra.min.x, rb.min.y - ra.min.y, dz),
+                dir: r.dir,
+                weight: 0.0,
+            };
+            if !mine.iter().any(|m| same_geometry(m, &v)) {
+                mine.push(v);
+            }
+        }
+        let n = mine.len() as f64;
+        for v in &mut mine {
+            v.weight = r.weight / n;
+        }
+        Some(mine)
+    }
+
+    /// The same system with every basic rule the file does not give (every
+    /// pair of its parts, every turn, every offset and side where a stud
+    /// connects them) added with weight `weight`: a rule no builder was seen
+    /// using is still allowed, only rarely tried. `None` adds nothing.
+    pub fn with_unseen(mut self, weight: Option<f64>) -> RuleSet {
+        self.rules.truncate(self.explicit);
+        self.variants
+            .retain(|v| (v.rule.0 as usize) < self.explicit);
+        self.unseen = weight;
+        let Some(w) = weight else {
+            return self;
+        };
+        type Key = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
+        let key = |v: &Variant| {
+            (
+                v.anchor,
+                v.anchor_rot,
+                v.added,
+                v.added_rot,
+                v.offset,
+                v.dir,
+            )
+        };
+        let mut seen: std::collections::HashSet<Key> = self.variants.iter().map(key).collect();
+        let parts = self.alphabet.clone();
+        for &a in &parts {
+            for &b in &parts {
+                for rot in Rot::ALL {
+                    if b.spec().canonical_rot(rot) != rot {
+                        continue;
+                    }
+                    let (ax, ay) = a.spec().footprint(Rot::R0);
+                    let (bx, by) = b.spec().footprint(rot);
+                    for dir in [Dir::Up, Dir::Down] {
+                        for dy in -(by - 1)..ay {
+                            for dx in -(bx - 1)..ax {
+                                let rule = Rule {
+                                    anchor: a,
+                                    added: b,
+                                    added_rot: rot,
+                                    dir,
+                                    dx,
+                                    dy,
+                                    weight: w,
+                                    line: 0,
+                                };
+                                let id = RuleId(self.rules.len() as u32);
+                                let Some(vs) = self.rule_variants(id, &rule) else {
+                                    continue;
+                                };
+                                if vs.iter().any(|v| seen.contains(&key(v))) {
+                                    continue;
+                                }
+                                seen.extend(vs.iter().map(key));
+                                self.variants.extend(vs);
+                                self.rules.push(rule);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self
+    }
+
+    /// The weight given to rules the file does not list, if any (the
+    /// `unseen` statement).
+    pub fn unseen(&self) -> Option<f64> {
+        self.unseen
+    }
+
+    /// The rules the file gives (the rest of [`RuleSet::rules`] are unseen
+    /// rules added by [`RuleSet::with_unseen`]).
+    pub fn explicit_rules(&self) -> &[Rule] {
+        &self.rules[..self.explicit]
     }
 
     /// Writes the rule set back as a rule file that [`RuleSet::parse`]
@@ -311,8 +404,15 @@ impl RuleSet {
         for st in &self.starts {
             s.push_str(&format!("start {}\n", st.part));
         }
+        if let Some(w) = self.unseen {
+            s.push_str(&format!(
+                "\n# every other connecting rule, as if seen with weight {}\nunseen {}\n",
+                fmt_weight(w),
+                fmt_weight(w)
+            ));
+        }
         s.push_str("\n#    anchor new    rot  dir   dx  dy  weight\n");
-        for r in &self.rules {
+        for r in self.explicit_rules() {
             s.push_str(&format!(
                 "rule {:<6} {:<6} {:<4} {:<5} {:>3} {:>3}  {}\n",
                 r.anchor.to_string(),
@@ -373,6 +473,49 @@ mod tests {
         assert_eq!(q.added_rot, Rot::R0);
         assert_eq!(q.offset, (0, 3, 1));
         assert_eq!(q.anchor, kind("3001"));
+    }
+
+    #[test]
+    fn unseen_rules_fill_in_every_other_connecting_joint() {
+        let seen = "part 3004\npart 3040b\nstart 3004\nrule 3004 3004 r0 up 1 0 7\n";
+        let bare = RuleSet::parse(seen, "t.rules".as_ref()).unwrap();
+        assert_eq!(bare.rules().len(), 1);
+        let text = format!("{seen}unseen 0.5\n");
+        let rs = RuleSet::parse(&text, "t.rules".as_ref()).unwrap();
+        assert_eq!(rs.explicit_rules().len(), 1);
+        assert!(rs.rules().len() > 20, "{}", rs.rules().len());
+        // The seen joint keeps its weight and is not repeated.
+        assert_eq!(rs.rules().iter().filter(|r| r.weight == 7.0).count(), 1);
+        assert!(rs.rules()[1..].iter().all(|r| r.weight == 0.5));
+        // Every added rule connects (slopes only through their back row).
+        for v in rs.variants() {
+            let a = rs.body(v.anchor, v.anchor_rot, Cell::new(0, 0, 0));
+            let (dx, dy, dz) = v.offset;
+            let b = rs.body(v.added, v.added_rot, Cell::new(dx, dy, dz));
+            assert!(if v.dir == Dir::Up {
+                a.holds(&b)
+            } else {
+                b.holds(&a)
+            });
+        }
+        // The file round-trips with the statement, not the added rules.
+        let back = rs.to_text("t");
+        assert!(back.contains("\nunseen 0.5\n") && back.matches("\nrule ").count() == 1);
+        let again = RuleSet::parse(&back, "t.rules".as_ref()).unwrap();
+        assert!(
+            again.variants() == rs.variants(),
+            "the round trip changed the rules"
+        );
+        // Restricting the alphabet regenerates them for the parts kept.
+        let bricks = rs
+            .restricted(|p| p.spec().family() == Family::Brick)
+            .unwrap();
+        assert!(bricks.rules().iter().all(|r| r.added.to_string() == "3004"));
+        let bad = RuleSet::parse(&format!("{seen}unseen -1\n"), "t.rules".as_ref());
+        assert!(bad
+            .unwrap_err()
+            .to_string()
+            .starts_with("t.rules:5: `unseen`"));
     }
 
     #[test]

@@ -7,6 +7,8 @@
 //! start 3001                           # a starting rule ε -> 3001
 //! rule  3001 3004 r90 up 3 0 12.5      # 3001 -> 3001 + 3004 turned r90, on top,
 //!                                      # its corner 3 studs along x: weight 12.5
+//! unseen 0.25                          # every other rule that connects two parts
+//!                                      # of the alphabet, each with weight 0.25
 //! ```
 //!
 //! Every error names the file and line and says what is wrong.
@@ -83,6 +85,7 @@ impl RuleSet {
         let mut alphabet: Vec<PartKind> = Vec::new();
         let mut starts: Vec<StartRule> = Vec::new();
         let mut rules: Vec<Rule> = Vec::new();
+        let mut unseen: Option<f64> = None;
         for (i, raw) in text.lines().enumerate() {
             let line = i + 1;
             let err = |m: String| RuleError::at(&file, line, m);
@@ -111,6 +114,22 @@ impl RuleSet {
                         return Err(err(format!("part {p} is declared twice")));
                     }
                     alphabet.push(p);
+                }
+                "unseen" => {
+                    let w = f.get(1).and_then(|w| w.parse::<f64>().ok());
+                    match (f.len(), w) {
+                        (2, Some(w)) if w.is_finite() && w > 0.0 => {
+                            if unseen.is_some() {
+                                return Err(err("`unseen` is given twice".into()));
+                            }
+                            unseen = Some(w);
+                        }
+                        _ => {
+                            return Err(err(
+                                "`unseen` takes one positive weight, e.g. `unseen 0.25`".into(),
+                            ))
+                        }
+                    }
                 }
                 "start" => {
                     if f.len() != 2 {
@@ -196,7 +215,7 @@ impl RuleSet {
                 message: "no `start` rules: nothing can begin a build".into(),
             });
         }
-        RuleSet::new(alphabet, starts, rules, file)
+        Ok(RuleSet::new(alphabet, starts, rules, file)?.with_unseen(unseen))
     }
 }
 
