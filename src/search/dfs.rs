@@ -208,6 +208,7 @@ impl<'a> PartSearch<'a> {
 
     /// Runs the backward tracing on `v` given the structure built before
     /// and the whole model `solid`.
+    #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         v: VoxelGrid,

@@ -526,8 +526,7 @@ pub(crate) fn face_fits(
         return true;
     };
     let inward = if up { -1 } else { 1 };
-    let found = open().any(|c| g.get(c) || g.get(c.offset(0, 0, inward)));
-    found
+    open().any(|c| g.get(c) || g.get(c.offset(0, 0, inward)))
 }
 
 /// The free-space check of the paper: can the piece `b` be brought to its

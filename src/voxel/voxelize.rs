@@ -220,7 +220,7 @@ impl Slant {
             // The facing in real units (cells are taller than wide).
             let n = (w[1] - w[0]).cross(w[2] - w[0]);
             let len = n.length();
-            if !(len > 0.0) {
+            if !len.is_normal() {
                 continue;
             }
             let n = n / len;
