@@ -24,6 +24,10 @@ use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
 use crate::voxel::{Slant, VoxelGrid};
 
+/// Matches the backward tracing of a part may look at per voxel of the
+/// part before it is generated forward instead.
+const MAX_TRIES_PER_VOXEL: u64 = 4_000;
+
 /// What one node may try at a cell.
 #[derive(Debug, Clone, Copy)]
 enum Slot {
@@ -231,6 +235,9 @@ impl<'a> PartSearch<'a> {
         );
         let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None, 0)];
         let mut nodes_here = 0u64;
+        // Matches looked at before the part is handed to forward growth: a
+        // big rule set (slopes, unseen rules) can make widened nodes slow.
+        let max_tries = stats.match_tries + MAX_TRIES_PER_VOXEL * total as u64 + 1_000_000;
         loop {
             if st.v.is_empty() {
                 return PartResult::Built(self.trace(&stack));
@@ -241,7 +248,10 @@ impl<'a> PartSearch<'a> {
                 stats.starts += 1;
                 return PartResult::Built(t);
             }
-            if nodes_here >= max_nodes || Instant::now() >= self.deadline {
+            if nodes_here >= max_nodes
+                || stats.match_tries >= max_tries
+                || Instant::now() >= self.deadline
+            {
                 return PartResult::OutOfBudget;
             }
             let top = stack.last_mut().expect("root frame");
