@@ -24,10 +24,18 @@ fn learning_the_corpus_gives_the_shipped_rules() {
         text == shipped,
         "rules/default.rules is not what `brickwright learn rules/examples` writes; regenerate it"
     );
-    assert_eq!(default_rules_text(), shipped, "the binary embeds the shipped file");
+    assert_eq!(
+        default_rules_text(),
+        shipped,
+        "the binary embeds the shipped file"
+    );
     // The corpus teaches bricks, plates and slopes.
     let rs = RuleSet::parse(&shipped, Path::new("rules/default.rules")).unwrap();
-    assert!(learned.report.builds.len() >= 12, "{} builds", learned.report.builds.len());
+    assert!(
+        learned.report.builds.len() >= 12,
+        "{} builds",
+        learned.report.builds.len()
+    );
     assert!(rs.explicit_rules().len() > 100);
     for id in ["3001", "3024", "3039", "3660a"] {
         assert!(
