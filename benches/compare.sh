@@ -8,7 +8,8 @@
 #   benches/compare.sh slopes MESH...   bricks alone against bricks and
 #       slopes (--slopes): bricks, slopes, voxels left out, seconds.
 #
-# STUDS sets the size (default 16), SEED the seed (default 1).
+# STUDS sets the size (default 16); SEED the seed of the slopes runs
+# (default 1), SEEDS the seeds averaged in the rules runs (default 1 to 5).
 set -euo pipefail
 what=${1:?usage: benches/compare.sh rules|slopes MESH...}
 shift
@@ -34,17 +35,29 @@ PY
 
 case "$what" in
 rules)
-  # The built-in rules, and the same rules with every weight 1.
+  # The built-in rules, and the same rules with every weight 1; each mesh
+  # built with every seed of SEEDS, the figures averaged.
   cp rules/default.rules "$out/learned.rules"
   awk '$1 == "rule" { $8 = 1 } $1 == "unseen" { $2 = 1 } { print }' "$out/learned.rules" >"$out/uniform.rules"
-  printf '| mesh | weights | pieces | voxels/piece | seams continued | nodes | search s |\n|---|---|---|---|---|---|---|\n'
-  for mesh in "$@"; do
-    name=$(basename "$mesh")
-    for w in learned uniform; do
-      "$bin" build "$mesh" -o "$out/$name-$w" --studs "$studs" --seed "$seed" --rules "$out/$w.rules" --quiet
-      row "$name" "$w" "$out/$name-$w"
-    done
-  done
+  python3 - "$bin" "$out" "$studs" "${SEEDS:-1 2 3 4 5}" "$@" <<'PY'
+import json, subprocess, sys
+bin, out, studs, seeds, meshes = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(), sys.argv[5:]
+print(f"| mesh | weights | pieces | voxels/piece | seams continued | nodes | search s |  (mean of seeds {' '.join(seeds)})")
+print("|---|---|---|---|---|---|---|")
+for mesh in meshes:
+    name = mesh.rsplit("/", 1)[-1]
+    for w in ["learned", "uniform"]:
+        rows = []
+        for seed in seeds:
+            d = f"{out}/{name}-{w}-{seed}"
+            subprocess.run([bin, "build", mesh, "-o", d, "--studs", studs, "--seed", seed,
+                            "--rules", f"{out}/{w}.rules", "--quiet"], check=True)
+            rows.append(json.load(open(f"{d}/report.json")))
+        mean = lambda f: sum(f(r) for r in rows) / len(rows)
+        print(f"| {name} | {w} | {mean(lambda r: r['pieces']):.0f} | {mean(lambda r: r['voxels_per_piece']):.2f} "
+              f"| {mean(lambda r: r['seams']['fraction']):.3f} | {mean(lambda r: r['search']['nodes']):.0f} "
+              f"| {mean(lambda r: r['seconds']['search']):.2f} |")
+PY
   ;;
 slopes)
   printf '| mesh | pieces from | pieces | bricks | slopes | voxels | left out | seams continued | search s |\n|---|---|---|---|---|---|---|---|---|\n'

@@ -27,6 +27,8 @@ pub fn all() -> Vec<Build> {
         structures::bridge(),
         structures::boat(),
         structures::tower(),
+        structures::solid_block(),
+        structures::thick_wall(),
         houses::house(),
         houses::cabin(),
         houses::jetty(),

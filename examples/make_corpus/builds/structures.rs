@@ -282,3 +282,48 @@ pub fn tower() -> Build {
     b.put(Part::Brick1x2, 0, 2, top, Turn::R90);
     b
 }
+
+/// A solid block 8 x 8, six courses of 2x bricks, each course laid across
+/// the one below, its joints at odd studs so no seam runs on up.
+pub fn solid_block() -> Build {
+    let mut b = Build::new(
+        "solid_block",
+        "Solid Block",
+        "a solid block 8 x 8 x 6 courses of 2x bricks, each course crossing the one below",
+        Colour::Red,
+    );
+    for c in 0..6 {
+        for r in 0..4 {
+            if c % 2 == 0 {
+                b.bricks(c * COURSE, (0, 2 * r), Dir::East, 2, &[3, 2, 3]);
+            } else {
+                b.bricks(c * COURSE, (2 * r, 0), Dir::South, 2, &[3, 2, 3]);
+            }
+        }
+    }
+    b
+}
+
+/// A wall two studs thick and 24 long, seven courses of 2x bricks in running
+/// bond: each course's joints fall between those of the course below.
+pub fn thick_wall() -> Build {
+    let mut b = Build::new(
+        "thick_wall",
+        "Thick Wall",
+        "a wall 2 studs thick, 24 long, 7 courses of 2x bricks in running bond",
+        Colour::White,
+    );
+    let courses: [&[i32]; 7] = [
+        &[4, 4, 4, 4, 4, 4],
+        &[2, 4, 4, 4, 4, 4, 2],
+        &[4, 8, 4, 8],
+        &[6, 8, 4, 6],
+        &[3, 6, 4, 8, 3],
+        &[8, 8, 8],
+        &[2, 4, 4, 4, 4, 4, 2],
+    ];
+    for (c, lengths) in (0..).zip(courses) {
+        b.bricks(c * COURSE, (0, 0), Dir::East, 2, lengths);
+    }
+    b
+}
