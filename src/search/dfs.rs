@@ -16,13 +16,13 @@ use std::time::Instant;
 
 use rand_chacha::ChaCha8Rng;
 
-use super::state::{Anchor, Removal, State};
+use super::state::{Anchor, Model, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
-use crate::voxel::{Slant, VoxelGrid};
+use crate::voxel::VoxelGrid;
 
 /// Matches the backward tracing of a part may look at per voxel of the
 /// part before it is generated forward instead.
@@ -211,14 +211,13 @@ impl<'a> PartSearch<'a> {
     }
 
     /// Runs the backward tracing on `v` given the structure built before
-    /// and the whole model `solid`.
+    /// and the whole `model`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         v: VoxelGrid,
         built: &VoxelGrid,
-        solid: &VoxelGrid,
-        slant: Option<&Slant>,
+        model: Model,
         max_nodes: u64,
         rng: &mut ChaCha8Rng,
         stats: &mut SearchStats,
@@ -228,8 +227,7 @@ impl<'a> PartSearch<'a> {
         let mut st = State::new(
             v,
             built,
-            solid,
-            slant,
+            model,
             self.rules.layer_ldu(),
             self.footprints.clone(),
         );

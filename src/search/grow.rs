@@ -20,13 +20,13 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::dfs::PartResult;
-use super::state::{face_fits, Anchor, Removal, State};
+use super::state::{face_fits, Anchor, Model, Removal, State};
 use super::{SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::{Cell, CellBox, Rot};
 use crate::grammar::RuleSet;
-use crate::voxel::{Slant, VoxelGrid};
+use crate::voxel::VoxelGrid;
 
 const NONE: u32 = u32::MAX;
 
@@ -56,8 +56,7 @@ struct Frame {
 pub(crate) fn grow(
     v: &mut VoxelGrid,
     built: &VoxelGrid,
-    solid: &VoxelGrid,
-    slant: Option<&Slant>,
+    model: Model,
     rules: &RuleSet,
     opts: &SearchOptions,
     deadline: Instant,
@@ -110,7 +109,7 @@ pub(crate) fn grow(
     // the first piece, the next seed is tried.
     let mut seed_k = 0usize;
     if built.is_empty() {
-        let Some(first) = start_at(v, solid, slant, u, &starts, seeds[0]) else {
+        let Some(first) = start_at(v, &model, u, &starts, seeds[0]) else {
             return PartResult::Unbuildable;
         };
         place(&first, &mut cover, &mut owner, 0);
@@ -205,7 +204,7 @@ pub(crate) fn grow(
                                 let b = p.body(u);
                                 if !v.all_set_body(&b)
                                     || cover.any_set_body(&b)
-                                    || !face_fits(solid, built, slant, p, &b)
+                                    || !face_fits(&model, built, p, &b)
                                 {
                                     return false;
                                 }
@@ -241,7 +240,7 @@ pub(crate) fn grow(
                         }
                         Anchor::Piece(a)
                     } else {
-                        if !State::links(built, &b) {
+                        if !model.joins_built(&b) {
                             continue;
                         }
                         Anchor::Built
@@ -307,13 +306,13 @@ pub(crate) fn grow(
                     cover.set_body(&p.body(u), false);
                     owner.iter_mut().for_each(|o| *o = NONE);
                     stack.clear();
-                    if let Some(first) = start_at(v, solid, slant, u, &starts, seeds[seed_k]) {
+                    if let Some(first) = start_at(v, &model, u, &starts, seeds[seed_k]) {
                         place(&first, &mut cover, &mut owner, 0);
                         placed.push((first, Anchor::Start, None));
                     }
                     continue;
                 }
-                let hopeless = !can_ever_cover(v, built, solid, slant, u, f.target, &pieces);
+                let hopeless = !can_ever_cover(v, built, &model, u, f.target, &pieces);
                 if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
                     // Repair: this voxel cannot be joined to the build in any
                     // way tried; leave it out and go on from here.
@@ -355,8 +354,7 @@ pub(crate) fn grow(
 fn can_ever_cover(
     v: &VoxelGrid,
     built: &VoxelGrid,
-    solid: &VoxelGrid,
-    slant: Option<&Slant>,
+    model: &Model,
     layer_ldu: i32,
     u: Cell,
     pieces: &[(PartKind, Rot)],
@@ -367,7 +365,7 @@ fn can_ever_cover(
             let b = local.moved(u.x - o.x, u.y - o.y, u.z - o.z);
             let p = Placement::new(part, b.bbox.min, rot);
             v.all_set_body(&b)
-                && face_fits(solid, built, slant, &p, &b)
+                && face_fits(model, built, &p, &b)
                 && (State::links(v, &b) || State::links(built, &b))
         });
         fits
@@ -378,8 +376,7 @@ fn can_ever_cover(
 /// fits the voxels.
 fn start_at(
     v: &VoxelGrid,
-    solid: &VoxelGrid,
-    slant: Option<&Slant>,
+    model: &Model,
     layer_ldu: i32,
     starts: &[(crate::catalog::PartKind, Rot)],
     seed: Cell,
@@ -391,10 +388,7 @@ fn start_at(
             for ox in 0..sx {
                 let p = Placement::new(part, seed.offset(-ox, -oy, 0), rot);
                 let b = p.body(layer_ldu);
-                if b.contains(seed)
-                    && v.all_set_body(&b)
-                    && face_fits(solid, &nothing, slant, &p, &b)
-                {
+                if b.contains(seed) && v.all_set_body(&b) && face_fits(model, &nothing, &p, &b) {
                     return Some(p);
                 }
             }

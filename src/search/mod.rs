@@ -197,33 +197,35 @@ pub fn build_guided(
     let mut stats = SearchStats::default();
     let (nx, ny, nz) = fixed.dims();
     let mut built = VoxelGrid::new(nx, ny, nz);
+    // Where the built structure carries studs and takes them: a piece
+    // rests on the built structure only through these.
+    let mut studs = VoxelGrid::new(nx, ny, nz);
+    let mut tubes = VoxelGrid::new(nx, ny, nz);
     let mut order: Vec<Removal> = Vec::new();
     let search = PartSearch::new(rules, opts, deadline);
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let mut finished = parts.len();
     for (i, part) in parts.iter_mut().enumerate() {
+        let model = state::Model {
+            solid: &fixed,
+            slant,
+            studs: &studs,
+            tubes: &tubes,
+        };
         let result = if built.is_empty() {
             grow::grow(
-                part, &built, &fixed, slant, rules, opts, deadline, &mut rng, &mut stats,
+                part, &built, model, rules, opts, deadline, &mut rng, &mut stats,
             )
         } else {
             // About twice the pieces the part needs: enough when the trace
             // goes straight through, and little lost when it does not.
             let budget = (part.count() as u64 / 2 + 256).min(opts.max_nodes_per_part);
-            match search.run(
-                part.clone(),
-                &built,
-                &fixed,
-                slant,
-                budget,
-                &mut rng,
-                &mut stats,
-            ) {
+            match search.run(part.clone(), &built, model, budget, &mut rng, &mut stats) {
                 PartResult::Built(t) => PartResult::Built(t),
                 _ if Instant::now() < deadline => {
                     stats.fallbacks += 1;
                     grow::grow(
-                        part, &built, &fixed, slant, rules, opts, deadline, &mut rng, &mut stats,
+                        part, &built, model, rules, opts, deadline, &mut rng, &mut stats,
                     )
                 }
                 other => other,
@@ -232,7 +234,10 @@ pub fn build_guided(
         match result {
             PartResult::Built(trace) => {
                 for r in trace.iter().rev() {
-                    built.set_body(&r.piece.body(rules.layer_ldu()), true);
+                    let b = r.piece.body(rules.layer_ldu());
+                    built.set_body(&b, true);
+                    studs.set_box(&b.studs, true);
+                    tubes.set_box(&b.tubes, true);
                     order.push(*r);
                 }
             }
@@ -439,11 +444,62 @@ mod part_tests {
     use crate::geom::{Cell, CellBox};
     use crate::grammar::default_rules_text;
 
+    /// The whole model `solid` on a built base of plain bricks, whose every
+    /// top cell carries studs and every bottom cell takes them.
+    fn model<'a>(solid: &'a VoxelGrid, built: &'a VoxelGrid) -> state::Model<'a> {
+        state::Model {
+            solid,
+            slant: None,
+            studs: built,
+            tubes: built,
+        }
+    }
+
     fn rules() -> RuleSet {
         RuleSet::parse(&default_rules_text(), "default.rules".as_ref())
             .unwrap()
             .restricted(|p| p.spec().family() == crate::catalog::Family::Brick)
             .unwrap()
+    }
+
+    /// A piece rests on the built structure only where studs meet tubes:
+    /// on a 33-degree slope's back row, not on its full-height middle row.
+    #[test]
+    fn only_studs_hold_a_piece_on_the_built_structure() {
+        let u = 12;
+        let slope = Placement::new(
+            crate::catalog::PartKind::from_id("4286").unwrap(),
+            Cell::new(0, 0, 0),
+            crate::geom::Rot::R0,
+        )
+        .body(u);
+        let (mut built, mut studs, mut tubes) = (
+            VoxelGrid::new(4, 4, 6),
+            VoxelGrid::new(4, 4, 6),
+            VoxelGrid::new(4, 4, 6),
+        );
+        built.set_body(&slope, true);
+        studs.set_box(&slope.studs, true);
+        tubes.set_box(&slope.tubes, true);
+        let m = state::Model {
+            solid: &built,
+            slant: None,
+            studs: &studs,
+            tubes: &tubes,
+        };
+        let brick = |y| {
+            Placement::new(
+                crate::catalog::PartKind::from_id("3005").unwrap(),
+                Cell::new(0, y, 2),
+                crate::geom::Rot::R0,
+            )
+            .body(u)
+        };
+        // The middle row (y = 1) is two layers tall like the back row, but
+        // has no studs.
+        assert!(built.get(Cell::new(0, 1, 1)));
+        assert!(!m.joins_built(&brick(1)));
+        assert!(m.joins_built(&brick(2)));
     }
 
     /// Backward tracing alone builds boxes resting on a built base: every
@@ -477,9 +533,14 @@ mod part_tests {
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
             let voxels = g.count();
-            let PartResult::Built(trace) =
-                search.run(g.clone(), &built, &g, None, 100_000, &mut rng, &mut stats)
-            else {
+            let PartResult::Built(trace) = search.run(
+                g.clone(),
+                &built,
+                model(&g, &built),
+                100_000,
+                &mut rng,
+                &mut stats,
+            ) else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
             let covered: i32 = trace.iter().map(|r| r.piece.body(24).volume()).sum();
@@ -517,9 +578,14 @@ mod part_tests {
             let search = PartSearch::new(&rules, &o, Instant::now() + Duration::from_secs(60));
             let mut stats = SearchStats::default();
             let mut rng = ChaCha8Rng::seed_from_u64(1);
-            let PartResult::Built(trace) =
-                search.run(g.clone(), &built, &g, None, 100_000, &mut rng, &mut stats)
-            else {
+            let PartResult::Built(trace) = search.run(
+                g.clone(),
+                &built,
+                model(&g, &built),
+                100_000,
+                &mut rng,
+                &mut stats,
+            ) else {
                 panic!("{sx}x{sy}x{sz} not built: {stats:?}");
             };
             let covered: i32 = trace.iter().map(|r| r.piece.body(24).volume()).sum();
@@ -553,8 +619,7 @@ mod part_tests {
             let r = grow::grow(
                 &mut g,
                 &built,
-                &solid,
-                None,
+                model(&solid, &built),
                 &rules,
                 &o,
                 Instant::now() + Duration::from_secs(60),

@@ -77,13 +77,10 @@ pub(crate) struct State<'g> {
     pub v: VoxelGrid,
     /// The structure built before this part: obstacles and anchors.
     pub built: &'g VoxelGrid,
-    /// Every voxel of the model, all parts: what a slope's sloping face
-    /// must keep clear of.
-    solid: &'g VoxelGrid,
+    /// The whole model and where the built structure's studs and tubes are.
+    model: Model<'g>,
     /// Height of a layer in LDU.
     pub layer_ldu: i32,
-    /// Where the mesh's surface slants, when known.
-    slant: Option<&'g Slant>,
     /// Committed piece per cell (or [`NONE`]).
     owner: Vec<u32>,
     /// Committed pieces; `alive` is false once peeled.
@@ -103,8 +100,7 @@ impl<'g> State<'g> {
     pub fn new(
         v: VoxelGrid,
         built: &'g VoxelGrid,
-        solid: &'g VoxelGrid,
-        slant: Option<&'g Slant>,
+        model: Model<'g>,
         layer_ldu: i32,
         footprints: Vec<(i32, i32)>,
     ) -> Self {
@@ -113,9 +109,8 @@ impl<'g> State<'g> {
         State {
             v,
             built,
-            solid,
+            model,
             layer_ldu,
-            slant,
             owner: vec![NONE; len],
             pieces: Vec::new(),
             peeled: VoxelGrid::new(nx, ny, nz),
@@ -163,7 +158,7 @@ impl<'g> State<'g> {
 
     /// Whether a slope's sloping face fits here: see [`face_fits`].
     pub fn face_clear(&self, p: &Placement, b: &Body) -> bool {
-        face_fits(self.solid, self.built, self.slant, p, b)
+        face_fits(&self.model, self.built, p, b)
     }
 
     /// Whether any committed piece is still in the grid.
@@ -190,7 +185,7 @@ impl<'g> State<'g> {
 
     /// Whether `b` stud-connects to the structure built before this part.
     pub fn touches_built(&self, b: &Body) -> bool {
-        Self::links(self.built, b)
+        self.model.joins_built(b)
     }
 
     /// Whether `b` connects to a piece matched earlier (the paper's
@@ -495,6 +490,29 @@ impl<'g> State<'g> {
     }
 }
 
+/// What every part's search needs to know of the whole model.
+#[derive(Clone, Copy)]
+pub(crate) struct Model<'a> {
+    /// Every voxel of the model, all parts: what a slope's sloping face
+    /// must keep clear of.
+    pub solid: &'a VoxelGrid,
+    /// Where the mesh's surface slants, when known.
+    pub slant: Option<&'a Slant>,
+    /// The top cells of the built structure that carry studs.
+    pub studs: &'a VoxelGrid,
+    /// The bottom cells of the built structure that take studs.
+    pub tubes: &'a VoxelGrid,
+}
+
+impl Model<'_> {
+    /// Whether `b` stud-connects to the built structure: its tubes on
+    /// built studs, or its studs under built tubes (a slope's front row
+    /// has no studs, an inverted slope's front row no tubes).
+    pub fn joins_built(&self, b: &Body) -> bool {
+        self.studs.any_set(&b.under_tubes()) || self.tubes.any_set(&b.over_studs())
+    }
+}
+
 /// Whether a slope's sloping face fits where `b` puts it: the face passes
 /// through the cells of its box the slope does not fill, so those must be
 /// clear of the model (`solid`) and the structure `built`; and where the
@@ -502,13 +520,8 @@ impl<'g> State<'g> {
 /// faces (up and toward the slope's front for a slope, down for an inverted
 /// one), in those cells or the slope's own cells next to them. Bricks and
 /// plates always fit.
-pub(crate) fn face_fits(
-    solid: &VoxelGrid,
-    built: &VoxelGrid,
-    slant: Option<&Slant>,
-    p: &Placement,
-    b: &Body,
-) -> bool {
+pub(crate) fn face_fits(m: &Model, built: &VoxelGrid, p: &Placement, b: &Body) -> bool {
+    let (solid, slant) = (m.solid, m.slant);
     if b.is_box() {
         return true;
     }
