@@ -15,6 +15,28 @@ use brickwright::grammar::{extended_alphabet, rules_text, DEFAULT_ALPHABET};
 use brickwright::pipeline::{self, BuildOptions, Progress, Silent};
 use brickwright::voxel::{Sizing, Up};
 
+/// `println!` that ends the program quietly when standard output has been
+/// closed (`brickwright verify x.ldr | head -1`) instead of panicking; the
+/// exit code is the shell's for a broken pipe.
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(141);
+        }
+    }};
+}
+
+/// `print!`, as [`outln!`].
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if write!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(141);
+        }
+    }};
+}
+
 /// Turn a 3D model into a LEGO build a person can assemble.
 #[derive(Parser)]
 #[command(name = "brickwright", version, about, long_about = None)]
@@ -183,35 +205,35 @@ fn run_build(a: BuildArgs) -> Result<()> {
     let out = pipeline::build(&opts, progress)?;
     if !a.quiet {
         let r = &out.report;
-        println!(
+        outln!(
             "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks high, verified",
             r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1],
             fmt_bricks(r.grid[2], r.layer_ldu)
         );
         for p in &r.parts {
-            println!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
+            outln!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
         }
         let rep = &r.repairs;
         if rep.budget_left_out > 0 {
-            println!(
+            outln!(
                 "  warning: the search ran out of time; the build stops below {} voxels it had no time for (raise --time-budget or lower --studs)",
                 rep.budget_left_out
             );
         }
         if !rep.is_empty() {
-            println!(
+            outln!(
                 "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make one-layer sheets two layers thick, {} voxels added to even flat tops to whole courses, {} voxels left out that no rule could join",
                 rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.dropped_unbuildable
             );
         }
-        println!(
+        outln!(
             "  seams: {} of {} vertical seams continue into the course above ({:.0}%; lower is stronger)",
             r.seams.continued,
             r.seams.seams,
             100.0 * r.seams.fraction
         );
         let s = &r.seconds;
-        println!(
+        outln!(
             "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, write {:.2}s",
             r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.write
         );
@@ -234,7 +256,7 @@ fn run_verify(file: PathBuf) -> Result<bool> {
     let asm = brickwright::ldraw::to_assembly(&model)?;
     let report = verify(&asm, None);
     if report.is_ok() {
-        println!(
+        outln!(
             "{}: OK: {} pieces, {} steps, one connected build",
             file.display(),
             asm.pieces.len(),
@@ -242,8 +264,8 @@ fn run_verify(file: PathBuf) -> Result<bool> {
         );
         Ok(true)
     } else {
-        println!("{}: {} problems", file.display(), report.failures.len());
-        println!("{report}");
+        outln!("{}: {} problems", file.display(), report.failures.len());
+        outln!("{report}");
         Ok(false)
     }
 }
@@ -256,7 +278,7 @@ fn run_rules(alphabet: Alphabet, output: Option<PathBuf>) -> Result<()> {
     match output {
         Some(p) => brickwright::fsutil::write_atomic(&p, |w| w.write_all(text.as_bytes()))
             .with_context(|| format!("{}: cannot write", p.display()))?,
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     Ok(())
 }
@@ -271,12 +293,12 @@ fn run_learn(a: LearnArgs) -> Result<()> {
     match &file {
         Some(p) => brickwright::fsutil::write_atomic(p, |w| w.write_all(text.as_bytes()))
             .with_context(|| format!("{}: cannot write", p.display()))?,
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     if !a.quiet {
         // The summary goes beside the rule file, never into it.
         match &file {
-            Some(p) => println!("{}  wrote {}", learned.summary(), p.display()),
+            Some(p) => outln!("{}  wrote {}", learned.summary(), p.display()),
             None => eprint!("{}", learned.summary()),
         }
     }

@@ -76,6 +76,20 @@ fn slopes_on_half_brick_layers_round_trip() {
     );
 }
 
+/// Slopes keep half-brick layers when read back even if every piece sits on
+/// a whole brick course: a slope's face needs them.
+#[test]
+fn slopes_on_brick_courses_read_back_on_half_brick_layers() {
+    let order = [
+        Placement::new(part("3001"), Cell::new(0, 0, 0), Rot::R0),
+        Placement::new(part("3039"), Cell::new(0, 0, 2), Rot::R0),
+    ];
+    let asm = Assembly::from_order(&order, 12, Color(4));
+    let back = round_trip(&asm);
+    assert_eq!(back.layer_ldu, 12);
+    assert_eq!(back, asm);
+}
+
 #[test]
 fn reader_shifts_the_lowest_corner_to_zero_and_keeps_steps_and_colours() {
     let p = |id, x, y, z, rot, step, color| Placed {

@@ -25,7 +25,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use crate::assembly::{Assembly, Placed, Placement, Step};
-use crate::catalog::{Color, PartKind};
+use crate::catalog::{Color, Family, PartKind};
 use crate::geom::{Cell, Rot};
 
 use super::{origin_offset, rot_matrix, LdrError, LDU_PER_PLATE, LDU_PER_STUD};
@@ -196,11 +196,19 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
 /// them (`z` the bottom in LDU), fit on: the largest that divides a brick
 /// (24 LDU), every piece's height and every bottom's height above the
 /// lowest. A brick for bricks on brick courses, 12 or 4 LDU for bricks half
-/// a brick apart, 8 once plates appear; 24 for no pieces.
+/// a brick apart or with slopes (whose faces need half-brick layers), 8 once
+/// plates appear; 24 for no pieces.
 pub fn layer_ldu_of<'a>(pieces: impl Iterator<Item = &'a Placement> + Clone) -> i32 {
     let low = pieces.clone().map(|p| p.origin.z).min().unwrap_or(0);
     pieces.fold(24, |g, p| {
-        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
+        // A slope's sloping face needs layers half a brick high at most.
+        let spec = p.part.spec();
+        let shape = if spec.family() == Family::Slope {
+            12
+        } else {
+            24
+        };
+        gcd(gcd(gcd(g, spec.height_ldu()), shape), p.origin.z - low)
     })
 }
 
