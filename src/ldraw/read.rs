@@ -200,16 +200,18 @@ pub fn to_assembly(model: &LdrModel) -> Result<Assembly, LdrError> {
 /// plates appear; 24 for no pieces.
 pub fn layer_ldu_of<'a>(pieces: impl Iterator<Item = &'a Placement> + Clone) -> i32 {
     let low = pieces.clone().map(|p| p.origin.z).min().unwrap_or(0);
-    pieces.fold(24, |g, p| {
-        // A slope's sloping face needs layers half a brick high at most.
-        let spec = p.part.spec();
-        let shape = if spec.family() == Family::Slope {
-            12
-        } else {
-            24
-        };
-        gcd(gcd(gcd(g, spec.height_ldu()), shape), p.origin.z - low)
-    })
+    let slopes = pieces
+        .clone()
+        .any(|p| p.part.spec().family() == Family::Slope);
+    let g = pieces.fold(24, |g, p| {
+        gcd(gcd(g, p.part.spec().height_ldu()), p.origin.z - low)
+    });
+    // A slope's sloping face needs layers half a brick high at most.
+    if slopes && g == 24 {
+        12
+    } else {
+        g
+    }
 }
 
 fn gcd(a: i32, b: i32) -> i32 {
