@@ -617,7 +617,11 @@ fn a_slope_on_a_brick_and_a_brick_on_a_slopes_back_row_are_learned() {
             ],
             "{t:?}"
         );
-        assert_eq!((l.report.starts, l.report.layer_ldu), (1, BRICK));
+        assert_eq!(
+            (l.report.starts, l.report.layer_ldu),
+            (1, 12),
+            "slopes need half-brick layers"
+        );
         let rs = loads(&l);
         // Slopes look different every way: four variants a rule.
         assert_eq!((rs.rules().len(), rs.variants().len()), (2, 8));
