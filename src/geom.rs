@@ -159,6 +159,22 @@ impl CellBox {
             && o.min.z < self.min.z + self.sz
     }
 
+    /// The smallest box holding both.
+    pub fn union(&self, o: &CellBox) -> CellBox {
+        let (a, b) = (self.max_excl(), o.max_excl());
+        let min = Cell::new(
+            self.min.x.min(o.min.x),
+            self.min.y.min(o.min.y),
+            self.min.z.min(o.min.z),
+        );
+        CellBox {
+            min,
+            sx: a.x.max(b.x) - min.x,
+            sy: a.y.max(b.y) - min.y,
+            sz: a.z.max(b.z) - min.z,
+        }
+    }
+
     /// Whether the footprints (x, y) of the two boxes overlap.
     pub const fn footprints_overlap(&self, o: &CellBox) -> bool {
         self.min.x < o.min.x + o.sx

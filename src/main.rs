@@ -141,6 +141,9 @@ struct BuildArgs {
     /// Group steps another way.
     #[arg(long, value_enum)]
     step_by: Option<StepBy>,
+    /// Test a complex rule (several pieces at once) once every K search nodes (the paper: 1 to 5); 0 never.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    complex_every: u32,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -197,7 +200,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
     opts.search = opts
         .search
         .with_seed(a.seed)
-        .with_time_budget(Duration::from_secs_f64(a.time_budget));
+        .with_time_budget(Duration::from_secs_f64(a.time_budget))
+        .with_complex_every(a.complex_every);
     let spinners = Spinners {
         bar: Default::default(),
     };

@@ -16,7 +16,7 @@ use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, StepGrouping};
 use crate::catalog::{Color, Family};
 use crate::fsutil::write_atomic;
-use crate::grammar::{default_rules_text, RuleError, RuleSet};
+use crate::grammar::{default_rules, RuleError, RuleSet};
 use crate::ldraw::{write_ldr, LdrMeta};
 use crate::mesh::{self, MeshError};
 use crate::search::{self, Repairs, SearchError, SearchOptions, SearchStats};
@@ -234,10 +234,7 @@ fn secs(t: Instant) -> f64 {
 pub fn load_rules(path: Option<&Path>) -> Result<RuleSet, RuleError> {
     match path {
         Some(p) => RuleSet::load(p),
-        None => RuleSet::parse(
-            &default_rules_text(),
-            Path::new("rules/default.rules (built in)"),
-        ),
+        None => Ok(default_rules()),
     }
 }
 

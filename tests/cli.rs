@@ -459,6 +459,7 @@ fn bad_options_fail_without_a_panic() {
         &["--time-budget", "nan"],
         &["--step-size", "0"],
         &["--up", "x"],
+        &["--complex-every", "-1"],
     ] {
         let tmp = tempdir();
         let out = tmp.path().join("out");
@@ -725,4 +726,16 @@ fn learn_rejects_bad_builds_with_one_line() {
     // No builds at all is a usage error.
     let run = run_in(tmp.path(), &["learn"]);
     assert_eq!(run.code, Some(2), "{}", run.describe());
+}
+
+#[test]
+fn complex_rules_are_tested_every_k_nodes_or_never() {
+    let (_, on) = build_verified("box.obj", &["--complex-every", "1"]);
+    let search = &on["search"];
+    let nodes = search["nodes"].as_u64().unwrap();
+    let tried = search["complex_tried"].as_u64().unwrap();
+    assert!(tried > 0 && tried <= nodes + 1, "{search}");
+    let (_, off) = build_verified("box.obj", &["--complex-every", "0"]);
+    assert_eq!(off["search"]["complex_tried"], 0);
+    assert_eq!(off["search"]["complex_applied"], 0);
 }

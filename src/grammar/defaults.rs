@@ -15,8 +15,12 @@
 //!          6  staggered, and B rests half on A (running bond)
 //! side   = 1 for up, 1/2 for down (people build upward)
 //! ```
+//!
+//! The generated files also carry the shipped complex rules of
+//! `rules/complex.rules` ([`COMPLEX_RULES`]) whose parts are in the alphabet.
 
 use std::collections::HashSet;
+use std::path::Path;
 
 use super::{Dir, Rule, RuleSet, StartRule};
 use crate::catalog::{Family, PartKind};
@@ -155,6 +159,13 @@ Statements (one a line, `#` starts a comment):
     (up) or underneath (down), with its minimum corner DX, DY studs from
     A's (x along A's long side). Turns of the whole rule are generated
     when the file is loaded, so each rule is written once.
+  complex NAME                         complex rule   u -> v (no weight), then
+    u PART ROT X Y Z                   a piece that must be in place, and
+    v PART ROT X Y Z                   a new piece, in the order they are added:
+    minimum corner X, Y in studs and bottom Z in plates (8 LDU) relative
+    to the first u piece (at 0 0 0). Each new piece stud-connects to a u
+    piece or to a new piece before it. The search tests one, picked with
+    equal probability, once every --complex-every nodes.
 
 Where the weights come from: a formula, no data; they encode building
 practice (Bedford, The Unofficial LEGO Builder's Guide, ch. 2):
@@ -162,6 +173,40 @@ practice (Bedford, The Unofficial LEGO Builder's Guide, ch. 2):
   joint  = 1 seam on seam, 2 inside A, 3 covers A, 4 staggered,
            6 staggered with B half on A (running bond)
   side   = 1 up, 0.5 down";
+
+/// The shipped complex rules, `rules/complex.rules`: a file of `complex`
+/// blocks only (see [`RuleSet::with_complex_text`]). No builds teach them
+/// (the paper collects no data for complex rules), so they are kept apart
+/// from the learned `rules/default.rules` and added to it by
+/// [`default_rules`] and to the files `brickwright rules` writes.
+pub const COMPLEX_RULES: &str = include_str!("../../rules/complex.rules");
+
+/// The built-in rules: the learned basic rules of `rules/default.rules`
+/// and the shipped complex rules of `rules/complex.rules`.
+pub fn default_rules() -> RuleSet {
+    RuleSet::parse(
+        &default_rules_text(),
+        Path::new("rules/default.rules (built in)"),
+    )
+    .and_then(|r| r.with_complex_text(COMPLEX_RULES, Path::new("rules/complex.rules (built in)")))
+    .expect("the built-in rules are valid")
+}
+
+/// The shipped complex rules whose parts are all in `set`'s alphabet and
+/// whose heights its layers can express.
+fn shipped_complex(set: &RuleSet) -> Vec<super::ComplexRule> {
+    let every: Vec<PartKind> = PartKind::all().collect();
+    let starts = every
+        .iter()
+        .map(|&part| StartRule { part, line: 0 })
+        .collect();
+    let all = RuleSet::new(every, starts, vec![], String::new())
+        .and_then(|s| s.with_complex_text(COMPLEX_RULES, Path::new("rules/complex.rules")))
+        .expect("the shipped complex rules are valid");
+    all.restricted(|p| set.alphabet().contains(&p))
+        .map(|r| r.complex().to_vec())
+        .unwrap_or_default()
+}
 
 /// The text of the shipped default rule file `rules/default.rules`: rule
 /// frequencies learned by `brickwright learn` from the example builds in
@@ -175,6 +220,10 @@ pub fn default_rules_text() -> String {
 /// header (the `--alphabet` value that makes it).
 pub fn rules_text(alphabet: &[&str], name: &str) -> String {
     let set = generate(alphabet);
+    let complex = shipped_complex(&set);
+    let set = set
+        .with_complex(complex)
+        .expect("the shipped complex rules fit the generated rules");
     set.to_text(&HEADER.replace("{ALPHA}", name))
 }
 

@@ -6,7 +6,9 @@
 //! - a **starting rule** `ε -> P` puts a first piece `P` down;
 //! - a **basic-form rule** `A -> A + B` adds a piece `B` stud-connected to an
 //!   existing piece `A`, either on top of it (`up`) or underneath (`down`),
-//!   at an offset and a rotation relative to `A`.
+//!   at an offset and a rotation relative to `A`;
+//! - a **complex rule** `u -> v` adds several pieces, in order, where
+//!   several pieces are in place (module [`complex`]; paper, Figure 4).
 //!
 //! Each rule carries a weight: how often people use it. The search samples
 //! rules from the categorical distribution of these weights, so common,
@@ -27,11 +29,16 @@
 //! assert_eq!(rules.variants().len(), 4);
 //! ```
 
+pub mod complex;
 mod defaults;
 pub mod learn;
 mod parse;
 
-pub use defaults::{default_rules_text, extended_alphabet, rules_text, DEFAULT_ALPHABET};
+pub use complex::{ComplexId, ComplexRule, ComplexVariant, Link, NewPiece, Plates, RulePiece};
+pub use defaults::{
+    default_rules, default_rules_text, extended_alphabet, rules_text, COMPLEX_RULES,
+    DEFAULT_ALPHABET,
+};
 pub use parse::RuleError;
 
 use serde::Serialize;
@@ -114,8 +121,17 @@ pub struct Variant {
     pub weight: f64,
 }
 
-/// The rewriting system: the alphabet, the starting rules, the basic rules
-/// and their rotated variants.
+/// Which rule added a piece.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum RuleRef {
+    /// A basic-form rule.
+    Basic(RuleId),
+    /// A complex rule.
+    Complex(ComplexId),
+}
+
+/// The rewriting system: the alphabet, the starting rules, the basic rules,
+/// the complex rules and their rotated variants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RuleSet {
     alphabet: Vec<PartKind>,
@@ -126,6 +142,8 @@ pub struct RuleSet {
     explicit: usize,
     unseen: Option<f64>,
     variants: Vec<Variant>,
+    complex: Vec<ComplexRule>,
+    complex_variants: Vec<ComplexVariant>,
     /// Where the rules came from, for reports.
     pub source: String,
 }
@@ -163,10 +181,25 @@ impl RuleSet {
             explicit,
             unseen: None,
             variants: Vec::new(),
+            complex: Vec::new(),
+            complex_variants: Vec::new(),
             source,
         };
         set.variants = set.generate_variants()?;
         Ok(set)
+    }
+
+    /// The same system with the complex rules `complex` (in place of any it
+    /// had), their turns generated.
+    ///
+    /// Errors, naming the rule file's line, if a piece is not in the
+    /// alphabet, a height is not a whole number of layers, two pieces
+    /// overlap, or a new piece is not stud-connected to a piece of `u` or a
+    /// new piece before it.
+    pub fn with_complex(mut self, complex: Vec<ComplexRule>) -> Result<RuleSet, RuleError> {
+        self.complex = complex;
+        self.complex_variants = self.generate_complex()?;
+        Ok(self)
     }
 
     /// The same system with Σ cut down to the parts `keep` accepts: their
@@ -194,7 +227,17 @@ impl RuleSet {
             .filter(|r| keep(r.anchor) && keep(r.added))
             .cloned()
             .collect();
-        Ok(RuleSet::new(alphabet, starts, rules, self.source.clone())?.with_unseen(self.unseen))
+        let set =
+            RuleSet::new(alphabet, starts, rules, self.source.clone())?.with_unseen(self.unseen);
+        // A complex rule whose heights the new layers cannot express (a
+        // plate's offset among bricks) goes with the parts it needs.
+        let complex = self
+            .complex
+            .iter()
+            .filter(|r| r.u.iter().chain(&r.v).all(|p| keep(p.part)) && set.fits_layers(r))
+            .cloned()
+            .collect();
+        set.with_complex(complex)
     }
 
     /// The letters of Σ.
@@ -227,6 +270,16 @@ impl RuleSet {
     /// Every rotation of every basic rule.
     pub fn variants(&self) -> &[Variant] {
         &self.variants
+    }
+
+    /// The complex rules, as written.
+    pub fn complex(&self) -> &[ComplexRule] {
+        &self.complex
+    }
+
+    /// Every distinct rotation of every complex rule, rule by rule.
+    pub fn complex_variants(&self) -> &[ComplexVariant] {
+        &self.complex_variants
     }
 
     /// Whether `part` has a starting rule.
@@ -424,6 +477,7 @@ impl RuleSet {
                 fmt_weight(r.weight)
             ));
         }
+        self.complex_text(&mut s);
         s
     }
 }

@@ -11,13 +11,30 @@
 //!                                      # of the alphabet, each with weight 0.25
 //! ```
 //!
+//! A complex rule (module [`complex`](super::complex)) is a block: a
+//! `complex NAME` line, then one line per piece, `u` for the pieces that
+//! must be in place and `v` for the new ones in the order they are added.
+//! A piece is its part, its turn and its minimum corner `X Y` in studs and
+//! `Z` in plates (8 LDU), relative to the first `u` piece, which is at
+//! `0 0 0`. The block ends at the next statement that is not a piece:
+//!
+//! ```text
+//! complex bridge                        # a 2x4 across two 1x2 columns
+//!   u 3004 r90  0 0 0                   #   a column, turned along y
+//!   u 3004 r90  2 0 0                   #   another, one stud away
+//!   v 3001 r0   0 0 3                   #   the 2x4 on both, a brick up
+//! ```
+//!
+//! Complex rules carry no weight: the search tests one, picked with equal
+//! probability, once every few nodes.
+//!
 //! Every error names the file and line and says what is wrong.
 
 use std::path::Path;
 
 use thiserror::Error;
 
-use super::{Dir, Rule, RuleSet, StartRule};
+use super::{ComplexRule, Dir, Plates, Rule, RulePiece, RuleSet, StartRule};
 use crate::catalog::PartKind;
 use crate::geom::Rot;
 
@@ -82,127 +99,14 @@ impl RuleSet {
     /// Parses rule-file text; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<RuleSet, RuleError> {
         let file = path.display().to_string();
-        let mut alphabet: Vec<PartKind> = Vec::new();
-        let mut starts: Vec<StartRule> = Vec::new();
-        let mut rules: Vec<Rule> = Vec::new();
-        let mut unseen: Option<f64> = None;
-        for (i, raw) in text.lines().enumerate() {
-            let line = i + 1;
-            let err = |m: String| RuleError::at(&file, line, m);
-            let body = raw.split('#').next().unwrap_or("").trim();
-            if body.is_empty() {
-                continue;
-            }
-            let f: Vec<&str> = body.split_whitespace().collect();
-            let part = |s: &str| {
-                PartKind::from_id(s).ok_or_else(|| {
-                    err(format!(
-                        "unknown part `{s}`: not in brickwright's parts catalog"
-                    ))
-                })
-            };
-            match f[0] {
-                "part" => {
-                    if f.len() != 2 {
-                        return Err(err(format!(
-                            "`part` takes one part id, found {}",
-                            f.len() - 1
-                        )));
-                    }
-                    let p = part(f[1])?;
-                    if alphabet.contains(&p) {
-                        return Err(err(format!("part {p} is declared twice")));
-                    }
-                    alphabet.push(p);
-                }
-                "unseen" => {
-                    let w = f.get(1).and_then(|w| w.parse::<f64>().ok());
-                    match (f.len(), w) {
-                        (2, Some(w)) if w.is_finite() && w > 0.0 => {
-                            if unseen.is_some() {
-                                return Err(err("`unseen` is given twice".into()));
-                            }
-                            unseen = Some(w);
-                        }
-                        _ => {
-                            return Err(err(
-                                "`unseen` takes one positive weight, e.g. `unseen 0.25`".into(),
-                            ))
-                        }
-                    }
-                }
-                "start" => {
-                    if f.len() != 2 {
-                        return Err(err(format!(
-                            "`start` takes one part id, found {}",
-                            f.len() - 1
-                        )));
-                    }
-                    let p = part(f[1])?;
-                    if !alphabet.contains(&p) {
-                        return Err(err(format!(
-                            "part {p} is not in the alphabet; declare it with `part {p}` first"
-                        )));
-                    }
-                    starts.push(StartRule { part: p, line });
-                }
-                "rule" => {
-                    if f.len() != 8 {
-                        return Err(err(format!(
-                            "`rule` takes 7 fields (anchor new rot up|down dx dy weight), found {}",
-                            f.len() - 1
-                        )));
-                    }
-                    let anchor = part(f[1])?;
-                    let added = part(f[2])?;
-                    let added_rot = Rot::parse(f[3]).ok_or_else(|| {
-                        err(format!(
-                            "bad rotation `{}`: use r0, r90, r180 or r270",
-                            f[3]
-                        ))
-                    })?;
-                    let dir = match f[4] {
-                        "up" => Dir::Up,
-                        "down" => Dir::Down,
-                        o => return Err(err(format!("bad direction `{o}`: use up or down"))),
-                    };
-                    let int = |s: &str, what: &str| {
-                        s.parse::<i32>()
-                            .map_err(|_| err(format!("bad {what} `{s}`: not an integer")))
-                    };
-                    let dx = int(f[5], "dx")?;
-                    let dy = int(f[6], "dy")?;
-                    let weight: f64 = f[7]
-                        .parse()
-                        .map_err(|_| err(format!("bad weight `{}`: not a number", f[7])))?;
-                    if !(weight.is_finite() && weight > 0.0) {
-                        return Err(err(format!("weight {} must be a positive number", f[7])));
-                    }
-                    let r = Rule {
-                        anchor,
-                        added,
-                        added_rot,
-                        dir,
-                        dx,
-                        dy,
-                        weight,
-                        line,
-                    };
-                    if let Some(prev) = rules.iter().find(|p| {
-                        (p.anchor, p.added, p.added_rot, p.dir, p.dx, p.dy)
-                            == (r.anchor, r.added, r.added_rot, r.dir, r.dx, r.dy)
-                    }) {
-                        return Err(err(format!("same rule as line {}", prev.line)));
-                    }
-                    rules.push(r);
-                }
-                other => {
-                    return Err(err(format!(
-                        "unknown statement `{other}`: expected part, start or rule"
-                    )))
-                }
-            }
-        }
+        let Statements {
+            alphabet,
+            starts,
+            rules,
+            unseen,
+            complex,
+            ..
+        } = statements(text, &file)?;
         if alphabet.is_empty() {
             return Err(RuleError::File {
                 file,
@@ -215,8 +119,323 @@ impl RuleSet {
                 message: "no `start` rules: nothing can begin a build".into(),
             });
         }
-        Ok(RuleSet::new(alphabet, starts, rules, file)?.with_unseen(unseen))
+        RuleSet::new(alphabet, starts, rules, file.clone())?
+            .with_unseen(unseen)
+            .with_complex(complex)
     }
+
+    /// Adds the complex rules of `text`, a file of `complex` blocks only
+    /// (such as `rules/complex.rules`), to this rule set's; `path` names
+    /// the file in errors.
+    pub fn with_complex_text(self, text: &str, path: &Path) -> Result<RuleSet, RuleError> {
+        let file = path.display().to_string();
+        let found = statements(text, &file)?;
+        let (line, what) = match (
+            found.alphabet.first(),
+            found.starts.first(),
+            found.rules.first(),
+        ) {
+            (Some(p), _, _) => (found.first_part_line, format!("`part {p}`")),
+            (_, Some(s), _) => (s.line, "`start`".to_string()),
+            (_, _, Some(r)) => (r.line, "`rule`".to_string()),
+            _ if found.unseen.is_some() => (found.unseen_line, "`unseen`".to_string()),
+            _ => (0, String::new()),
+        };
+        if !what.is_empty() {
+            return Err(RuleError::at(
+                &file,
+                line,
+                format!("{what} in a file of complex rules: it may hold only `complex` blocks"),
+            ));
+        }
+        let mut complex = self.complex.clone();
+        for r in &found.complex {
+            if let Some(prev) = complex
+                .iter()
+                .find(|p| p.name == r.name || p.same_pieces(r))
+            {
+                return Err(RuleError::at(
+                    &file,
+                    r.line,
+                    format!(
+                        "complex rule `{}` repeats `{}` of {}:{}",
+                        r.name, prev.name, self.source, prev.line
+                    ),
+                ));
+            }
+            complex.push(r.clone());
+        }
+        // Checked with this file's name in the messages, then merged.
+        let alone = RuleSet {
+            source: file,
+            ..self.clone()
+        };
+        alone.with_complex(found.complex)?;
+        self.with_complex(complex)
+    }
+}
+
+/// The statements of a rule file, in file order.
+struct Statements {
+    alphabet: Vec<PartKind>,
+    starts: Vec<StartRule>,
+    rules: Vec<Rule>,
+    unseen: Option<f64>,
+    complex: Vec<ComplexRule>,
+    /// The line of the first `part` statement.
+    first_part_line: usize,
+    /// The line of the `unseen` statement.
+    unseen_line: usize,
+}
+
+/// Reads the statements of rule-file text; `file` names it in errors.
+fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
+    let mut alphabet: Vec<PartKind> = Vec::new();
+    let mut starts: Vec<StartRule> = Vec::new();
+    let mut rules: Vec<Rule> = Vec::new();
+    let mut complex: Vec<ComplexRule> = Vec::new();
+    // Whether the last statement belongs to an open `complex` block.
+    let mut in_block = false;
+    let mut first_part_line = 0;
+    let mut unseen: Option<f64> = None;
+    let mut unseen_line = 0;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let err = |m: String| RuleError::at(file, line, m);
+        let body = raw.split('#').next().unwrap_or("").trim();
+        if body.is_empty() {
+            continue;
+        }
+        let f: Vec<&str> = body.split_whitespace().collect();
+        if in_block && !matches!(f[0], "u" | "v") {
+            in_block = false;
+            check_block(&complex, file)?;
+        }
+        let part = |s: &str| {
+            PartKind::from_id(s).ok_or_else(|| {
+                err(format!(
+                    "unknown part `{s}`: not in brickwright's parts catalog"
+                ))
+            })
+        };
+        match f[0] {
+            "part" => {
+                if f.len() != 2 {
+                    return Err(err(format!(
+                        "`part` takes one part id, found {}",
+                        f.len() - 1
+                    )));
+                }
+                let p = part(f[1])?;
+                if alphabet.contains(&p) {
+                    return Err(err(format!("part {p} is declared twice")));
+                }
+                if alphabet.is_empty() {
+                    first_part_line = line;
+                }
+                alphabet.push(p);
+            }
+            "unseen" => {
+                let w = f.get(1).and_then(|w| w.parse::<f64>().ok());
+                match (f.len(), w) {
+                    (2, Some(w)) if w.is_finite() && w > 0.0 => {
+                        if unseen.is_some() {
+                            return Err(err("`unseen` is given twice".into()));
+                        }
+                        unseen = Some(w);
+                        unseen_line = line;
+                    }
+                    _ => {
+                        return Err(err(
+                            "`unseen` takes one positive weight, e.g. `unseen 0.25`".into(),
+                        ))
+                    }
+                }
+            }
+            "start" => {
+                if f.len() != 2 {
+                    return Err(err(format!(
+                        "`start` takes one part id, found {}",
+                        f.len() - 1
+                    )));
+                }
+                let p = part(f[1])?;
+                if !alphabet.contains(&p) {
+                    return Err(err(format!(
+                        "part {p} is not in the alphabet; declare it with `part {p}` first"
+                    )));
+                }
+                starts.push(StartRule { part: p, line });
+            }
+            "rule" => {
+                if f.len() != 8 {
+                    return Err(err(format!(
+                        "`rule` takes 7 fields (anchor new rot up|down dx dy weight), found {}",
+                        f.len() - 1
+                    )));
+                }
+                let anchor = part(f[1])?;
+                let added = part(f[2])?;
+                let added_rot = Rot::parse(f[3]).ok_or_else(|| {
+                    err(format!(
+                        "bad rotation `{}`: use r0, r90, r180 or r270",
+                        f[3]
+                    ))
+                })?;
+                let dir = match f[4] {
+                    "up" => Dir::Up,
+                    "down" => Dir::Down,
+                    o => return Err(err(format!("bad direction `{o}`: use up or down"))),
+                };
+                let int = |s: &str, what: &str| {
+                    s.parse::<i32>()
+                        .map_err(|_| err(format!("bad {what} `{s}`: not an integer")))
+                };
+                let dx = int(f[5], "dx")?;
+                let dy = int(f[6], "dy")?;
+                let weight: f64 = f[7]
+                    .parse()
+                    .map_err(|_| err(format!("bad weight `{}`: not a number", f[7])))?;
+                if !(weight.is_finite() && weight > 0.0) {
+                    return Err(err(format!("weight {} must be a positive number", f[7])));
+                }
+                let r = Rule {
+                    anchor,
+                    added,
+                    added_rot,
+                    dir,
+                    dx,
+                    dy,
+                    weight,
+                    line,
+                };
+                if let Some(prev) = rules.iter().find(|p| {
+                    (p.anchor, p.added, p.added_rot, p.dir, p.dx, p.dy)
+                        == (r.anchor, r.added, r.added_rot, r.dir, r.dx, r.dy)
+                }) {
+                    return Err(err(format!("same rule as line {}", prev.line)));
+                }
+                rules.push(r);
+            }
+            "complex" => {
+                let name = match f[..] {
+                    [_, name] => name,
+                    _ => {
+                        return Err(err(format!(
+                            "`complex` takes one name, found {}",
+                            f.len() - 1
+                        )))
+                    }
+                };
+                if let Some(prev) = complex.iter().find(|r| r.name == name) {
+                    return Err(err(format!(
+                        "complex rule `{name}` is already defined on line {}",
+                        prev.line
+                    )));
+                }
+                complex.push(ComplexRule {
+                    name: name.to_string(),
+                    u: Vec::new(),
+                    v: Vec::new(),
+                    line,
+                });
+                in_block = true;
+            }
+            tag @ ("u" | "v") => {
+                if !in_block {
+                    return Err(err(format!(
+                        "`{tag}` outside a complex rule: start the block with `complex NAME`"
+                    )));
+                }
+                if f.len() != 6 {
+                    return Err(err(format!(
+                        "`{tag}` takes 5 fields (part rot x y z), found {}",
+                        f.len() - 1
+                    )));
+                }
+                let int = |s: &str, what: &str| {
+                    s.parse::<i32>()
+                        .map_err(|_| err(format!("bad {what} `{s}`: not an integer")))
+                };
+                let piece = RulePiece {
+                    part: part(f[1])?,
+                    rot: Rot::parse(f[2]).ok_or_else(|| {
+                        err(format!(
+                            "bad rotation `{}`: use r0, r90, r180 or r270",
+                            f[2]
+                        ))
+                    })?,
+                    x: int(f[3], "x")?,
+                    y: int(f[4], "y")?,
+                    z: Plates(int(f[5], "z (plates)")?),
+                    line,
+                };
+                let r = complex.last_mut().expect("an open block");
+                if tag == "u" && r.u.is_empty() && (piece.x, piece.y, piece.z.0) != (0, 0, 0) {
+                    return Err(err(format!(
+                            "the first `u` piece is the origin of the others: put it at 0 0 0, not {} {} {}",
+                            piece.x, piece.y, piece.z.0
+                        )));
+                }
+                if tag == "u" && !r.v.is_empty() {
+                    return Err(err(
+                        "`u` after a `v`: give the pieces in place first, then the new ones".into(),
+                    ));
+                }
+                if tag == "u" {
+                    r.u.push(piece);
+                } else {
+                    r.v.push(piece);
+                }
+            }
+            other => {
+                return Err(err(format!(
+                    "unknown statement `{other}`: expected part, start, rule, unseen or complex"
+                )))
+            }
+        }
+    }
+    if in_block {
+        check_block(&complex, file)?;
+    }
+    Ok(Statements {
+        alphabet,
+        starts,
+        rules,
+        unseen,
+        complex,
+        first_part_line,
+        unseen_line,
+    })
+}
+
+/// The checks of a complete `complex` block: both sides have pieces, and
+/// no earlier rule has the same ones.
+fn check_block(complex: &[ComplexRule], file: &str) -> Result<(), RuleError> {
+    let (r, earlier) = complex.split_last().expect("an open block");
+    for (side, pieces) in [("u", &r.u), ("v", &r.v)] {
+        if pieces.is_empty() {
+            return Err(RuleError::at(
+                file,
+                r.line,
+                format!(
+                    "complex rule `{}` has no `{side}` pieces: add a `{side} PART ROT X Y Z` line",
+                    r.name
+                ),
+            ));
+        }
+    }
+    if let Some(prev) = earlier.iter().find(|p| p.same_pieces(r)) {
+        return Err(RuleError::at(
+            file,
+            r.line,
+            format!(
+                "complex rule `{}` has the same pieces as `{}` on line {}",
+                r.name, prev.name, prev.line
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

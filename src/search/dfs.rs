@@ -10,18 +10,23 @@
 //! be pressed into place (the flood-fill check), and must leave voxels that
 //! can still form one connected build. A node with no applicable rule is
 //! backtracked. Starting rules are always tried: when the voxels left are
-//! exactly one piece, or a piece rests on the structure built before.
+//! exactly one piece, or a piece rests on the structure built before. Once
+//! every `complex_every` nodes, one complex rule picked with equal
+//! probability is tested first: the node scans every cell for it before
+//! its sampled rules (module `complex`).
 
 use std::time::Instant;
 
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::state::{Anchor, Model, Removal, State};
-use super::{SearchOptions, SearchStats};
+use super::complex::{self, Reverse};
+use super::state::{Anchor, Change, Model, Removal, State};
+use super::{Dice, SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Body, Cell, Rot};
-use crate::grammar::{Dir, RuleSet};
+use crate::geom::{Body, Cell, CellBox, Rot};
+use crate::grammar::{Dir, RuleRef, RuleSet};
 use crate::voxel::VoxelGrid;
 
 /// Matches the backward tracing of a part may look at per voxel of the
@@ -35,10 +40,17 @@ enum Slot {
     Rule(u32),
     /// A starting rule's piece resting on the built structure.
     OnBuilt(PartKind, Rot),
+    /// A complex rule's rotated variant, by index, with its new piece of
+    /// this index matched at the cell.
+    Complex(u32, u8),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
+    /// Scanning the up order for the complex rule picked for this node,
+    /// before any basic rule (every cell, as the paper tests each rule
+    /// over the whole grid).
+    Complex,
     /// Scanning top-down for up rules and pieces on the built structure
     /// (with nothing built: up and down rules together, outside in).
     Up,
@@ -46,12 +58,18 @@ enum Phase {
     Down,
     /// Matches that do not touch the matched pieces, held back.
     Deferred,
+    /// Once every rule has been tried: the up scan again, from the top,
+    /// taking matches that do not touch the matched pieces (more may exist
+    /// than were held back).
+    Loose,
     Done,
 }
 
 struct Frame {
     /// The change that led here from the parent (None at the root).
-    applied: Option<Removal>,
+    applied: Option<Change>,
+    /// The variants of the complex rule picked for this node, if any.
+    complex: Vec<Slot>,
     up: Vec<Slot>,
     down: Vec<Slot>,
     phase: Phase,
@@ -67,14 +85,25 @@ struct Frame {
     widened: bool,
 }
 
+/// A match that passed the structural checks.
+// Candidates are made for every structural match in the hot scan: boxing
+// the bigger basic variant would allocate for each.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
-struct Candidate {
+enum Candidate {
+    Basic(Basic),
+    Complex(Reverse),
+}
+
+/// A basic rule's (or a starting piece's) match.
+#[derive(Debug, Clone, Copy)]
+struct Basic {
     piece: Placement,
     b: Body,
     committed: Option<u32>,
     anchor: Anchor,
     anchor_box: Option<(Body, Option<u32>)>,
-    rule: Option<crate::grammar::RuleId>,
+    rule: Option<RuleRef>,
 }
 
 /// How a part's search ended.
@@ -99,6 +128,8 @@ pub(crate) struct PartSearch<'a> {
     wide_down: (Vec<Slot>, Vec<u32>),
     wide_all: (Vec<Slot>, Vec<u32>),
     weights: Vec<f64>,
+    /// Each complex rule's variants, as the slots that try them.
+    complex: Vec<Vec<Slot>>,
     deadline: Instant,
 }
 
@@ -126,6 +157,10 @@ impl<'a> PartSearch<'a> {
                     (v.added, v.added_rot)
                 }
                 Slot::OnBuilt(p, r) => (p, r),
+                Slot::Complex(i, j) => {
+                    let n = &rules.complex_variants()[i as usize].v[j as usize];
+                    (n.piece.part, n.piece.rot)
+                }
             };
             let mut ends = vec![slots.len() as u32; slots.len()];
             for k in (0..slots.len().saturating_sub(1)).rev() {
@@ -144,6 +179,16 @@ impl<'a> PartSearch<'a> {
         }
         let wide_down = group(&|d| d == Dir::Down);
         let wide_all = group(&|_| true);
+        let mut complex: Vec<Vec<Slot>> = Vec::new();
+        let mut last = None;
+        for (i, var) in rules.complex_variants().iter().enumerate() {
+            if last != Some(var.rule) {
+                complex.push(Vec::new());
+                last = Some(var.rule);
+            }
+            let slots = complex.last_mut().expect("a group");
+            slots.extend((0..var.v.len()).map(|j| Slot::Complex(i as u32, j as u8)));
+        }
         PartSearch {
             rules,
             opts,
@@ -153,6 +198,7 @@ impl<'a> PartSearch<'a> {
             wide_down,
             wide_all,
             weights,
+            complex,
             deadline,
         }
     }
@@ -182,26 +228,44 @@ impl<'a> PartSearch<'a> {
         (lo + (hi - lo) * done * done).round() as usize
     }
 
+    /// A node's frame; the `nth` node of the part (from 1) scans for a
+    /// complex rule, picked with equal probability, before its sampled
+    /// rules if `nth` is a multiple of `complex_every`.
+    #[allow(clippy::too_many_arguments)]
     fn frame(
         &self,
         st: &State,
         total: usize,
-        rng: &mut ChaCha8Rng,
-        applied: Option<Removal>,
+        rng: &mut Dice,
+        applied: Option<Change>,
         start: usize,
+        nth: u64,
+        stats: &mut SearchStats,
     ) -> Frame {
         let b = self.branching(st.v.count(), total);
-        let (mut up, mut down) = self.sample(b, rng);
+        let k = u64::from(self.opts.complex_every);
+        let mut complex: Vec<Slot> = Vec::new();
+        if k > 0 && !self.complex.is_empty() && nth % k == 0 {
+            complex = self.complex[rng.complex.gen_range(0..self.complex.len())].clone();
+            stats.complex_tried += 1;
+        }
+        let (mut up, mut down) = self.sample(b, &mut rng.rules);
         if st.has_built() {
             up.extend(self.starts.iter().map(|&(p, r)| Slot::OnBuilt(p, r)));
         } else {
             up.append(&mut down);
         }
+        let phase = if complex.is_empty() {
+            Phase::Up
+        } else {
+            Phase::Complex
+        };
         Frame {
             applied,
+            complex,
             up,
             down,
-            phase: Phase::Up,
+            phase,
             pos: 0,
             start,
             slot: 0,
@@ -219,7 +283,7 @@ impl<'a> PartSearch<'a> {
         built: &VoxelGrid,
         model: Model,
         max_nodes: u64,
-        rng: &mut ChaCha8Rng,
+        rng: &mut Dice,
         stats: &mut SearchStats,
     ) -> PartResult {
         let total = v.count();
@@ -231,7 +295,7 @@ impl<'a> PartSearch<'a> {
             self.rules.layer_ldu(),
             self.footprints.clone(),
         );
-        let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None, 0)];
+        let mut stack: Vec<Frame> = vec![self.frame(&st, total, rng, None, 0, 1, stats)];
         let mut nodes_here = 0u64;
         // Matches looked at before the part is handed to forward growth: a
         // big rule set (slopes, unseen rules) can make widened nodes slow.
@@ -255,23 +319,27 @@ impl<'a> PartSearch<'a> {
             let top = stack.last_mut().expect("root frame");
             match self.next_candidate(&mut st, top, &orders, stats) {
                 Some(c) => {
-                    let removal = apply(&mut st, &c);
+                    let change = self.apply(&mut st, &c);
+                    if let Candidate::Complex(_) = c {
+                        stats.complex_applied += 1;
+                    }
                     nodes_here += 1;
                     stats.nodes += 1;
-                    let start = if top.phase == Phase::Up && !orders.0.is_empty() {
+                    let scan_up = matches!(top.phase, Phase::Up | Phase::Complex);
+                    let start = if scan_up && !orders.0.is_empty() {
                         (top.start + top.pos) % orders.0.len()
                     } else {
                         0
                     };
-                    let f = self.frame(&st, total, rng, Some(removal), start);
+                    let f = self.frame(&st, total, rng, Some(change), start, nodes_here + 1, stats);
                     stack.push(f);
                     stats.max_depth = stats.max_depth.max(stack.len() as u64);
                 }
                 None => {
                     let f = stack.pop().expect("frame");
                     match f.applied {
-                        Some(r) => {
-                            st.undo(&r);
+                        Some(ch) => {
+                            st.undo_change(&ch);
                             stats.backtracks += 1;
                         }
                         None => {
@@ -284,7 +352,11 @@ impl<'a> PartSearch<'a> {
     }
 
     fn trace(&self, stack: &[Frame]) -> Vec<Removal> {
-        stack.iter().filter_map(|f| f.applied).collect()
+        stack
+            .iter()
+            .filter_map(|f| f.applied.as_ref())
+            .flat_map(|ch| ch.removals.iter().copied())
+            .collect()
     }
 
     /// The starting rule `ε -> P`, reversed: the voxels left are one piece.
@@ -336,29 +408,38 @@ impl<'a> PartSearch<'a> {
                             return Some(c);
                         }
                     }
-                    f.phase = Phase::Done;
+                    f.phase = if f.widened { Phase::Loose } else { Phase::Done };
+                    f.pos = 0;
+                    f.slot = 0;
                 }
-                Phase::Up | Phase::Down => {
-                    let order = if f.phase == Phase::Up {
-                        &orders.0
-                    } else {
-                        &orders.1
-                    };
-                    let (slots, ends): (&[Slot], &[u32]) = match (f.widened, f.phase == Phase::Up) {
+                Phase::Complex | Phase::Up | Phase::Down | Phase::Loose => {
+                    let loose = f.phase == Phase::Loose;
+                    let up = f.phase != Phase::Down;
+                    let order = if up { &orders.0 } else { &orders.1 };
+                    let (slots, ends): (&[Slot], &[u32]) = match (f.widened, up) {
+                        _ if f.phase == Phase::Complex => (&f.complex, &[]),
                         (false, true) => (&f.up, &[]),
                         (false, false) => (&f.down, &[]),
                         (true, true) if built => (&self.wide_up.0, &self.wide_up.1),
                         (true, true) => (&self.wide_all.0, &self.wide_all.1),
                         (true, false) => (&self.wide_down.0, &self.wide_down.1),
                     };
-                    let shift = if f.phase == Phase::Up { f.start } else { 0 };
+                    let shift = if matches!(f.phase, Phase::Up | Phase::Complex) {
+                        f.start
+                    } else {
+                        0
+                    };
                     let at = |pos: usize| order[(shift + pos) % order.len()];
                     while f.pos < order.len() && !st.v.get(at(f.pos)) {
                         f.pos += 1;
                         f.slot = 0;
                     }
                     if f.pos >= order.len() {
-                        if f.phase == Phase::Up && built {
+                        if f.phase == Phase::Complex {
+                            f.phase = Phase::Up;
+                        } else if loose {
+                            f.phase = Phase::Done;
+                        } else if f.phase == Phase::Up && built {
                             f.phase = Phase::Down;
                         } else {
                             f.deferred.reverse();
@@ -389,19 +470,31 @@ impl<'a> PartSearch<'a> {
                             }
                         }
                         if let Some(c) = self.match_at(st, slot, cell, &mut fit) {
-                            if !built && !st.on_side_boundary(&c.b.bbox) {
+                            if !built && !st.on_side_boundary(&c.bbox()) {
                                 continue;
                             }
                             // With nothing built, the matched piece to continue
                             // from is a committed anchor: peel it next, so the
                             // peel follows the chain of staggered joints.
-                            let connected = if !built {
-                                c.committed.is_some() || !st.has_committed()
-                            } else {
-                                !st.any_matched
-                                    || c.committed.is_some()
-                                    || matches!(c.anchor_box, Some((_, Some(_))))
-                                    || st.touches_matched(&c.b)
+                            let connected = match &c {
+                                _ if loose => true,
+                                Candidate::Basic(c) if !built => {
+                                    c.committed.is_some() || !st.has_committed()
+                                }
+                                Candidate::Basic(c) => {
+                                    !st.any_matched
+                                        || c.committed.is_some()
+                                        || matches!(c.anchor_box, Some((_, Some(_))))
+                                        || st.touches_matched(&c.b)
+                                }
+                                Candidate::Complex(m) if !built => {
+                                    m.committed || !st.has_committed()
+                                }
+                                Candidate::Complex(m) => {
+                                    !st.any_matched
+                                        || m.committed
+                                        || complex::touches_matched(st, self.rules, m)
+                                }
                             };
                             if !connected {
                                 if f.deferred.len() < 256 {
@@ -440,6 +533,9 @@ impl<'a> PartSearch<'a> {
         fit: &mut Option<(PartKind, Rot, Option<Option<u32>>)>,
     ) -> Option<Candidate> {
         match slot {
+            Slot::Complex(i, j) => {
+                complex::match_at(st, self.rules, i, j as usize, cell).map(Candidate::Complex)
+            }
             Slot::Rule(i) => {
                 let v = &self.rules.variants()[i as usize];
                 let (piece, b) = self.at_key(v.added, v.added_rot, cell);
@@ -463,14 +559,14 @@ impl<'a> PartSearch<'a> {
                     return None;
                 }
                 let a_committed = st.commitment(&a, &anchor)?;
-                Some(Candidate {
+                Some(Candidate::Basic(Basic {
                     piece,
                     b,
                     committed,
                     anchor: Anchor::Piece(anchor),
                     anchor_box: Some((a, a_committed)),
-                    rule: Some(v.rule),
-                })
+                    rule: Some(RuleRef::Basic(v.rule)),
+                }))
             }
             Slot::OnBuilt(part, rot) => {
                 let (piece, b) = self.at_key(part, rot, cell);
@@ -478,14 +574,14 @@ impl<'a> PartSearch<'a> {
                     return None;
                 }
                 let committed = st.commitment(&b, &piece)?;
-                Some(Candidate {
+                Some(Candidate::Basic(Basic {
                     piece,
                     b,
                     committed,
                     anchor: Anchor::Built,
                     anchor_box: None,
                     rule: None,
-                })
+                }))
             }
         }
     }
@@ -493,6 +589,10 @@ impl<'a> PartSearch<'a> {
     /// The checks that need the removal applied: placeability and
     /// connectivity. Leaves the state unchanged.
     fn passes(&self, st: &mut State, c: &Candidate, stats: &mut SearchStats) -> bool {
+        let c = match c {
+            Candidate::Basic(c) => c,
+            Candidate::Complex(m) => return self.passes_complex(st, m, stats),
+        };
         let r = apply(st, c);
         let new_anchor = match c.anchor_box {
             Some((ab, None)) => Some(ab),
@@ -511,6 +611,49 @@ impl<'a> PartSearch<'a> {
         }
         st.undo(&r);
         ok
+    }
+}
+
+impl PartSearch<'_> {
+    /// [`PartSearch::passes`] for a complex rule: each new piece placeable
+    /// once peeled, the voxels left still connected and coverable.
+    fn passes_complex(&self, st: &mut State, m: &Reverse, stats: &mut SearchStats) -> bool {
+        let Some(ch) = complex::apply(st, self.rules, m, true) else {
+            stats.rejected_placeable += 1;
+            return false;
+        };
+        let ok_conn = st.still_connected(&m.bbox, Some(&m.u_bbox));
+        let ok = ok_conn && st.still_reachable(&m.bbox, Some(&m.u_bbox));
+        if !ok_conn {
+            stats.rejected_connect += 1;
+        } else if !ok {
+            stats.rejected_reach += 1;
+        }
+        st.undo_change(&ch);
+        ok
+    }
+
+    /// Applies a candidate's reverse rule application to the state.
+    fn apply(&self, st: &mut State, c: &Candidate) -> Change {
+        match c {
+            Candidate::Basic(c) => Change {
+                removals: vec![apply(st, c)],
+                commits: Vec::new(),
+            },
+            Candidate::Complex(m) => {
+                complex::apply(st, self.rules, m, false).expect("a match that passed its checks")
+            }
+        }
+    }
+}
+
+impl Candidate {
+    /// The box the new pieces take.
+    fn bbox(&self) -> CellBox {
+        match self {
+            Candidate::Basic(c) => c.b.bbox,
+            Candidate::Complex(m) => m.bbox,
+        }
     }
 }
 
@@ -545,8 +688,8 @@ fn scan_orders(v: &VoxelGrid, built: bool) -> (Vec<Cell>, Vec<Cell>) {
     (up, down)
 }
 
-/// Applies a candidate's reverse rule application to the state.
-fn apply(st: &mut State, c: &Candidate) -> Removal {
+/// Applies a basic match's reverse rule application to the state.
+fn apply(st: &mut State, c: &Basic) -> Removal {
     st.apply(
         c.piece,
         &c.b,

@@ -11,7 +11,11 @@
 //! the same adaptive branching factor, depth first with backtracking. The
 //! voxel nearest the first piece that is still uncovered is the one the next
 //! piece must cover, so the build grows outward and stays connected by
-//! construction. The result is handed on as the equivalent backward trace.
+//! construction. Once every `complex_every` nodes, one complex rule picked
+//! with equal probability is tried first: its `u` pieces must all be placed
+//! already, and its new pieces go in together, in their order, as one node
+//! (undone together on backtracking). The result is handed on as the
+//! equivalent backward trace.
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -21,11 +25,11 @@ use rand_chacha::ChaCha8Rng;
 
 use super::dfs::PartResult;
 use super::state::{face_fits, Anchor, Model, Removal, State};
-use super::{SearchOptions, SearchStats};
+use super::{Dice, SearchOptions, SearchStats};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Cell, CellBox, Rot};
-use crate::grammar::RuleSet;
+use crate::geom::{Body, Cell, CellBox, Rot};
+use crate::grammar::{ComplexVariant, Link, RuleRef, RuleSet};
 use crate::voxel::VoxelGrid;
 
 const NONE: u32 = u32::MAX;
@@ -33,15 +37,27 @@ const NONE: u32 = u32::MAX;
 /// Seeds tried for the first piece before voxels are left out.
 const MAX_SEEDS: usize = 16;
 
+/// What one node may try over its target voxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Slot {
+    /// A basic rule's rotated variant, by index.
+    Rule(u32),
+    /// A starting piece resting on the structure built before, by index.
+    OnBuilt(u32),
+    /// A complex rule's rotated variant, by index.
+    Complex(u32),
+}
+
 struct Frame {
     target: Cell,
-    slots: Vec<u32>,
+    slots: Vec<Slot>,
     slot: usize,
     corner: usize,
     widened: bool,
     /// Whether the look-ahead was switched off after every rule failed.
     relaxed: bool,
-    placed: bool,
+    /// Pieces the node's current choice placed (0: none yet).
+    placed: usize,
     /// For each new piece's shape tried so far, the placements over the
     /// target that fit the free voxels and can be pressed in: many rules
     /// share a shape, and the fit does not change while the frame lives.
@@ -60,7 +76,7 @@ pub(crate) fn grow(
     rules: &RuleSet,
     opts: &SearchOptions,
     deadline: Instant,
-    rng: &mut ChaCha8Rng,
+    rng: &mut Dice,
     stats: &mut SearchStats,
 ) -> PartResult {
     let Some(bounds) = v.bounds() else {
@@ -92,7 +108,7 @@ pub(crate) fn grow(
     let by_layer = !built.is_empty() || bounds.sz > 2;
     let mut cover = VoxelGrid::new(nx, ny, nz);
     let mut owner = vec![NONE; v.len()];
-    let mut placed: Vec<(Placement, Anchor, Option<crate::grammar::RuleId>)> = Vec::new();
+    let mut placed: Vec<Choice> = Vec::new();
 
     let starts = super::start_shapes(rules);
     let u = rules.layer_ldu();
@@ -118,20 +134,25 @@ pub(crate) fn grow(
     }
     let n_rules = rules.variants().len() as u32;
     let weights: Vec<f64> = rules.variants().iter().map(|x| x.weight).collect();
-    let mut by_shape: Vec<u32> = (0..n_rules).collect();
-    by_shape.sort_by_key(|&i| {
-        let x = &rules.variants()[i as usize];
-        (
-            std::cmp::Reverse(x.added.spec().studs()),
-            x.added,
-            x.added_rot,
-            i,
-        )
-    });
-    // Slots past the rules are starting pieces resting on the built part.
+    let mut by_shape: Vec<Slot> = {
+        let mut order: Vec<u32> = (0..n_rules).collect();
+        order.sort_by_key(|&i| {
+            let x = &rules.variants()[i as usize];
+            (
+                std::cmp::Reverse(x.added.spec().studs()),
+                x.added,
+                x.added_rot,
+                i,
+            )
+        });
+        order.into_iter().map(Slot::Rule).collect()
+    };
+    // Starting pieces resting on the built part come after the rules.
     if !built.is_empty() {
-        by_shape.extend((0..starts.len() as u32).map(|k| n_rules + k));
+        by_shape.extend((0..starts.len() as u32).map(Slot::OnBuilt));
     }
+    let complex = complex_groups(rules);
+    let mut frames_made = 0u64;
     let shapes = super::footprints(rules);
     let pieces: Vec<(PartKind, Rot)> = rules
         .alphabet()
@@ -157,13 +178,27 @@ pub(crate) fn grow(
         if Instant::now() >= deadline {
             return PartResult::OutOfBudget;
         }
-        if stack.last().is_none_or(|f| f.placed) {
+        if stack.last().is_none_or(|f| f.placed > 0) {
             let target = nearest_uncovered(v, &cover, built, by_layer, &dist);
             let done = 1.0 - left as f64 / total as f64;
             let b = (opts.b_min as f64 + (opts.b_max - opts.b_min) as f64 * done * done) as usize;
-            let mut slots = sample(&weights, b, rng);
+            frames_made += 1;
+            let mut slots: Vec<Slot> = Vec::new();
+            // Once every k nodes, one complex rule, picked with equal
+            // probability, is tested before the sampled basic rules.
+            let k = u64::from(opts.complex_every);
+            if k > 0 && !complex.is_empty() && frames_made % k == 0 {
+                let pick = rng.complex.gen_range(0..complex.len());
+                slots.extend(complex[pick].clone().map(Slot::Complex));
+                stats.complex_tried += 1;
+            }
+            slots.extend(
+                sample(&weights, b, &mut rng.rules)
+                    .into_iter()
+                    .map(Slot::Rule),
+            );
             if !built.is_empty() && on_built(target) {
-                slots.extend((0..starts.len() as u32).map(|k| n_rules + k));
+                slots.extend((0..starts.len() as u32).map(Slot::OnBuilt));
             }
             stack.push(Frame {
                 target,
@@ -172,21 +207,60 @@ pub(crate) fn grow(
                 corner: 0,
                 widened: false,
                 relaxed: false,
-                placed: false,
+                placed: 0,
                 fits: HashMap::new(),
             });
         }
         let at_root = stack.len() == 1;
         let f = stack.last_mut().expect("frame");
-        let mut found: Option<(Placement, Anchor, Option<u32>)> = None;
+        let mut found: Vec<Choice> = Vec::new();
         'scan: loop {
             while f.slot < f.slots.len() {
-                let si = f.slots[f.slot];
-                let (added, added_rot) = if si < n_rules {
-                    let x = &rules.variants()[si as usize];
-                    (x.added, x.added_rot)
-                } else {
-                    starts[(si - n_rules) as usize]
+                let slot = f.slots[f.slot];
+                if let Slot::Complex(ci) = slot {
+                    let var = &rules.complex_variants()[ci as usize];
+                    let corners: usize = var
+                        .v
+                        .iter()
+                        .map(|n| n.piece.body(Cell::new(0, 0, 0), u).volume() as usize)
+                        .sum();
+                    while f.corner < corners {
+                        // The corner-th cell of the new pieces, in order,
+                        // goes on the target voxel.
+                        let c = nth_new_cell(var, f.corner, u);
+                        f.corner += 1;
+                        stats.match_tries += 1;
+                        if stats.match_tries % 65_536 == 0 && Instant::now() >= deadline {
+                            return PartResult::OutOfBudget;
+                        }
+                        let grids = Grids {
+                            v,
+                            cover: &mut cover,
+                            built,
+                            model: &model,
+                            owner: &owner,
+                            placed: &placed,
+                            layer_ldu: u,
+                        };
+                        let origin = f.target.offset(-c.x, -c.y, -c.z);
+                        if let Some(pieces) =
+                            match_complex(grids, var, origin, f.relaxed, &shapes, stats)
+                        {
+                            found = pieces;
+                            break 'scan;
+                        }
+                    }
+                    f.slot += 1;
+                    f.corner = 0;
+                    continue;
+                }
+                let (added, added_rot) = match slot {
+                    Slot::Rule(i) => {
+                        let x = &rules.variants()[i as usize];
+                        (x.added, x.added_rot)
+                    }
+                    Slot::OnBuilt(k) => starts[k as usize],
+                    Slot::Complex(_) => unreachable!("complex slots are handled above"),
                 };
                 // Every way the piece can lie over the target voxel.
                 let target = f.target;
@@ -225,25 +299,20 @@ pub(crate) fn grow(
                         return PartResult::OutOfBudget;
                     }
                     let b = p.body(u);
-                    let anchor = if si < n_rules {
-                        let x = &rules.variants()[si as usize];
+                    let (anchor, rule) = if let Slot::Rule(i) = slot {
+                        let x = &rules.variants()[i as usize];
                         let (dx, dy, dz) = x.offset;
                         let a =
                             Placement::new(x.anchor, p.origin.offset(-dx, -dy, -dz), x.anchor_rot);
-                        let key = a.body(u).key();
-                        if !cover.in_bounds(key) {
+                        if owner_of(&owner, &placed, v, &a.body(u)) != Some(a) {
                             continue;
                         }
-                        let id = owner[v.index(key)];
-                        if id == NONE || placed[id as usize].0 != a {
-                            continue;
-                        }
-                        Anchor::Piece(a)
+                        (Anchor::Piece(a), Some(RuleRef::Basic(x.rule)))
                     } else {
                         if !model.joins_built(&b) {
                             continue;
                         }
-                        Anchor::Built
+                        (Anchor::Built, None)
                     };
                     cover.set_body(&b, true);
                     let ok = f.relaxed || still_coverable(v, &cover, built, &b.bbox, &shapes);
@@ -252,11 +321,7 @@ pub(crate) fn grow(
                         stats.rejected_reach += 1;
                         continue;
                     }
-                    found = Some((
-                        p,
-                        anchor,
-                        (si < n_rules).then(|| rules.variants()[si as usize].rule.0),
-                    ));
+                    found.push((p, anchor, rule));
                     break 'scan;
                 }
                 f.slot += 1;
@@ -274,78 +339,239 @@ pub(crate) fn grow(
                 f.corner = 0;
                 continue;
             }
-            let tried: std::collections::HashSet<u32> = f.slots.iter().copied().collect();
+            let tried: std::collections::HashSet<Slot> = f.slots.iter().copied().collect();
             f.slots = by_shape
                 .iter()
                 .copied()
-                .filter(|i| !tried.contains(i))
+                .filter(|s| !tried.contains(s))
                 .collect();
             f.slot = 0;
             f.corner = 0;
             f.widened = true;
             stats.widened += 1;
         }
-        match found {
-            Some((p, anchor, rule)) => {
+        if !found.is_empty() {
+            if matches!(found[0].2, Some(RuleRef::Complex(_))) {
+                stats.complex_applied += 1;
+            }
+            f.placed = found.len();
+            for (p, anchor, rule) in found {
                 let id = placed.len() as u32;
                 place(&p, &mut cover, &mut owner, id);
-                placed.push((p, anchor, rule.map(crate::grammar::RuleId)));
+                placed.push((p, anchor, rule));
                 if anchor == Anchor::Built {
                     stats.starts += 1;
                 }
-                f.placed = true;
-                stats.nodes += 1;
-                stats.max_depth = stats.max_depth.max(placed.len() as u64);
-                // The child frame is made on the next turn.
             }
+            stats.nodes += 1;
+            stats.max_depth = stats.max_depth.max(placed.len() as u64);
+            // The child frame is made on the next turn.
+            continue;
+        }
+        if built.is_empty() && at_root && placed.len() == 1 && seed_k + 1 < seeds.len() {
+            // Stuck right at the start: start elsewhere.
+            seed_k += 1;
+            let (p, _, _) = placed.pop().expect("the first piece");
+            cover.set_body(&p.body(u), false);
+            owner.iter_mut().for_each(|o| *o = NONE);
+            stack.clear();
+            if let Some(first) = start_at(v, &model, u, &starts, seeds[seed_k]) {
+                place(&first, &mut cover, &mut owner, 0);
+                placed.push((first, Anchor::Start, None));
+            }
+            continue;
+        }
+        let hopeless = !can_ever_cover(v, built, &model, u, f.target, &pieces);
+        if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
+            // Repair: this voxel cannot be joined to the build in any
+            // way tried; leave it out and go on from here.
+            let t = f.target;
+            v.set(t, false);
+            stats.dropped_unbuildable += 1;
+            stack.pop();
+            continue;
+        }
+        // Dead end: undo the pieces that led here (all the new pieces of a
+        // complex rule together) and try the parent's next option.
+        stack.pop();
+        stats.backtracks += 1;
+        backtracks_here += 1;
+        let n = stack.last().map_or(1, |p| p.placed);
+        for _ in 0..n {
+            let (p, _, _) = placed.pop().expect("a placed piece per frame");
+            let b = p.body(u);
+            cover.set_body(&b, false);
+            for c in b.cells() {
+                owner[v.index(c)] = NONE;
+            }
+        }
+        match stack.last_mut() {
+            Some(parent) => parent.placed = 0,
             None => {
-                if built.is_empty() && at_root && placed.len() == 1 && seed_k + 1 < seeds.len() {
-                    // Stuck right at the start: start elsewhere.
-                    seed_k += 1;
-                    let (p, _, _) = placed.pop().expect("the first piece");
-                    cover.set_body(&p.body(u), false);
-                    owner.iter_mut().for_each(|o| *o = NONE);
-                    stack.clear();
-                    if let Some(first) = start_at(v, &model, u, &starts, seeds[seed_k]) {
-                        place(&first, &mut cover, &mut owner, 0);
-                        placed.push((first, Anchor::Start, None));
-                    }
+                // The piece came from the root frame of a part on a
+                // built structure: there is no parent frame.
+                if !built.is_empty() {
                     continue;
                 }
-                let hopeless = !can_ever_cover(v, built, &model, u, f.target, &pieces);
-                if backtracks_here >= opts.max_backtracks_per_part || at_root || hopeless {
-                    // Repair: this voxel cannot be joined to the build in any
-                    // way tried; leave it out and go on from here.
-                    let t = f.target;
-                    v.set(t, false);
-                    stats.dropped_unbuildable += 1;
-                    stack.pop();
-                    continue;
-                }
-                // Dead end: undo the piece that led here and try its next option.
-                stack.pop();
-                stats.backtracks += 1;
-                backtracks_here += 1;
-                let (p, _, _) = placed.pop().expect("a placed piece per frame");
-                let b = p.body(u);
-                cover.set_body(&b, false);
-                for c in b.cells() {
-                    owner[v.index(c)] = NONE;
-                }
-                match stack.last_mut() {
-                    Some(parent) => parent.placed = false,
-                    None => {
-                        // The piece came from the root frame of a part on a
-                        // built structure: there is no parent frame.
-                        if !built.is_empty() {
-                            continue;
-                        }
-                        return PartResult::Unbuildable;
-                    }
-                }
+                return PartResult::Unbuildable;
             }
         }
     }
+}
+
+/// A placed piece, what it is attached to, and the rule that added it.
+type Choice = (Placement, Anchor, Option<RuleRef>);
+
+/// The grids and pieces of a growth, for matching a complex rule.
+struct Grids<'a> {
+    v: &'a VoxelGrid,
+    cover: &'a mut VoxelGrid,
+    built: &'a VoxelGrid,
+    model: &'a Model<'a>,
+    owner: &'a [u32],
+    placed: &'a [Choice],
+    layer_ldu: i32,
+}
+
+/// The placed piece that holds the key cell of `b`, if any.
+fn owner_of(owner: &[u32], placed: &[Choice], v: &VoxelGrid, b: &Body) -> Option<Placement> {
+    let key = b.key();
+    if !v.in_bounds(key) {
+        return None;
+    }
+    let id = owner[v.index(key)];
+    (id != NONE).then(|| placed[id as usize].0)
+}
+
+/// The variant indices of each complex rule.
+fn complex_groups(rules: &RuleSet) -> Vec<std::ops::Range<u32>> {
+    let mut out: Vec<std::ops::Range<u32>> = Vec::new();
+    for (i, var) in rules.complex_variants().iter().enumerate() {
+        let i = i as u32;
+        match out.last_mut() {
+            Some(r) if rules.complex_variants()[r.start as usize].rule == var.rule => r.end = i + 1,
+            _ => out.push(i..i + 1),
+        }
+    }
+    out
+}
+
+/// The `k`-th cell of the new pieces of `var`, in order, with its first
+/// `u` piece at the origin.
+fn nth_new_cell(var: &ComplexVariant, mut k: usize, layer_ldu: i32) -> Cell {
+    for n in &var.v {
+        let b = n.piece.body(Cell::new(0, 0, 0), layer_ldu);
+        let cells = b.volume() as usize;
+        if k < cells {
+            return b.cells().nth(k).expect("a cell of the body");
+        }
+        k -= cells;
+    }
+    unreachable!("k is less than the new pieces' volume")
+}
+
+/// The complex variant `var` with its first `u` piece at `origin`, if it
+/// applies: every `u` piece is a placed piece, every new piece fits
+/// uncovered voxels with its sloping face clear and can be pressed into
+/// place after the ones before it, and (unless `relaxed`) every voxel near
+/// them can still be covered. Returns the new pieces in order, each
+/// anchored to the piece it stud-connects to.
+fn match_complex(
+    g: Grids<'_>,
+    var: &ComplexVariant,
+    origin: Cell,
+    relaxed: bool,
+    shapes: &[(i32, i32)],
+    stats: &mut SearchStats,
+) -> Option<Vec<Choice>> {
+    let at = |p: &crate::grammar::complex::VariantPiece| {
+        Placement::new(p.part, origin.offset(p.at.x, p.at.y, p.at.z), p.rot)
+    };
+    let mut olds: Vec<Placement> = Vec::with_capacity(var.u.len());
+    for p in &var.u {
+        let a = at(p);
+        if owner_of(g.owner, g.placed, g.v, &a.body(g.layer_ldu)) != Some(a) {
+            return None;
+        }
+        olds.push(a);
+    }
+    let news: Vec<(Placement, Body)> = var
+        .v
+        .iter()
+        .map(|n| {
+            let p = at(&n.piece);
+            (p, p.body(g.layer_ldu))
+        })
+        .collect();
+    if !news.iter().all(|(p, b)| {
+        g.v.all_set_body(b) && !g.cover.any_set_body(b) && face_fits(g.model, g.built, p, b)
+    }) {
+        return None;
+    }
+    // A new piece pressed on top of its anchor may not roof over voxels
+    // still to cover: the growth covers the lowest voxels first, and a
+    // piece the rule lays ahead of it (running bond's far half) would leave
+    // them to be slid in sideways, which is seldom possible.
+    let body = |l: Link| match l {
+        Link::U(k) => olds[k].body(g.layer_ldu),
+        Link::V(k) => news[k].1,
+    };
+    for (n, (_, b)) in var.v.iter().zip(&news) {
+        if body(n.anchor).holds(b) {
+            let under = b.under_tubes();
+            let open = under
+                .cells()
+                .any(|c| g.v.get(c) && !g.cover.get(c) && !news.iter().any(|(_, o)| o.contains(c)));
+            if open {
+                return None;
+            }
+        }
+    }
+    // Each new piece must go in with the ones before it in place.
+    let mut placeable = true;
+    let mut set = 0;
+    for (_, b) in &news {
+        if !super::state::placeable(g.cover, g.built, &b.bbox) {
+            placeable = false;
+            break;
+        }
+        g.cover.set_body(b, true);
+        set += 1;
+    }
+    let ok = placeable
+        && (relaxed || {
+            let all = news
+                .iter()
+                .map(|(_, b)| b.bbox)
+                .reduce(|a, b| a.union(&b))
+                .expect("a new piece");
+            still_coverable(g.v, g.cover, g.built, &all, shapes)
+        });
+    for (_, b) in &news[..set] {
+        g.cover.set_body(b, false);
+    }
+    if !placeable {
+        stats.rejected_placeable += 1;
+        return None;
+    }
+    if !ok {
+        stats.rejected_reach += 1;
+        return None;
+    }
+    let rule = Some(RuleRef::Complex(var.rule));
+    Some(
+        var.v
+            .iter()
+            .zip(&news)
+            .map(|(n, &(p, _))| {
+                let anchor = match n.anchor {
+                    Link::U(k) => olds[k],
+                    Link::V(k) => news[k].0,
+                };
+                (p, Anchor::Piece(anchor), rule)
+            })
+            .collect(),
+    )
 }
 
 /// Whether some piece over `u` fits the part's voxels and has a voxel of the

@@ -8,7 +8,7 @@
 use crate::assembly::Placement;
 use crate::catalog::Shape;
 use crate::geom::{Body, Cell, CellBox};
-use crate::grammar::RuleId;
+use crate::grammar::RuleRef;
 use crate::voxel::{Slant, VoxelGrid};
 
 /// Positions the placeability flood fill visits before it gives up.
@@ -35,8 +35,9 @@ pub struct Removal {
     pub piece: Placement,
     /// What it is attached to.
     pub anchor: Anchor,
-    /// The rule applied, if a basic rule.
-    pub rule: Option<RuleId>,
+    /// The rule that added it: a basic or complex rule, or `None` for a
+    /// starting rule or a piece resting on the structure built before.
+    pub rule: Option<RuleRef>,
     /// Committed-piece id the removed piece had, if it was already matched.
     was_committed: Option<u32>,
     /// Committed-piece id created for a newly matched anchor.
@@ -47,7 +48,7 @@ pub struct Removal {
 
 impl Removal {
     /// A piece placed by forward generation, as its backward removal.
-    pub(crate) fn forward(piece: Placement, anchor: Anchor, rule: Option<RuleId>) -> Removal {
+    pub(crate) fn forward(piece: Placement, anchor: Anchor, rule: Option<RuleRef>) -> Removal {
         Removal {
             piece,
             anchor,
@@ -69,6 +70,17 @@ impl Removal {
             marked: false,
         }
     }
+}
+
+/// A node's local change: the removals of one reverse rule application
+/// (one for a basic rule, one per new piece for a complex rule, last added
+/// first) and the pieces of a complex rule's `u` it committed.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Change {
+    /// The pieces peeled, in the order peeled.
+    pub removals: Vec<Removal>,
+    /// Committed-piece ids created for `u` pieces, in the order created.
+    pub commits: Vec<u32>,
 }
 
 /// The mutable search state of one part.
@@ -209,7 +221,7 @@ impl<'g> State<'g> {
         was_committed: Option<u32>,
         anchor: Anchor,
         anchor_box: Option<(&Body, Option<u32>)>,
-        rule: Option<RuleId>,
+        rule: Option<RuleRef>,
     ) -> Removal {
         self.v.set_body(b, false);
         if let Some(id) = was_committed {
@@ -239,6 +251,38 @@ impl<'g> State<'g> {
             was_committed,
             new_anchor,
             marked: !prev,
+        }
+    }
+
+    /// Commits `p` (whose body is `b`, every cell uncommitted) as a matched
+    /// piece that stays in the grid. Returns its id for [`State::uncommit`].
+    pub fn commit(&mut self, p: Placement, b: &Body) -> u32 {
+        let id = self.pieces.len() as u32;
+        self.pieces.push((p, true));
+        for c in b.cells() {
+            let i = self.v.index(c);
+            self.owner[i] = id;
+        }
+        id
+    }
+
+    /// Undoes [`State::commit`]; `id` must be the last committed piece.
+    pub fn uncommit(&mut self, id: u32) {
+        let (p, _) = self.pieces.pop().expect("a committed piece");
+        debug_assert_eq!(id as usize, self.pieces.len());
+        for c in p.body(self.layer_ldu).cells() {
+            let i = self.v.index(c);
+            self.owner[i] = NONE;
+        }
+    }
+
+    /// Undoes a node's change, which must be the last applied.
+    pub fn undo_change(&mut self, ch: &Change) {
+        for r in ch.removals.iter().rev() {
+            self.undo(r);
+        }
+        for &id in ch.commits.iter().rev() {
+            self.uncommit(id);
         }
     }
 
