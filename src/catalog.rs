@@ -11,6 +11,9 @@ use serde::Serialize;
 
 use crate::geom::{Body, Cell, CellBox, Rot, MAX_BODY_BOXES};
 
+mod color;
+pub use color::{Color, ColorSpec, Palette, COLORS, LAYER_PALETTE, RANDOM_PALETTE};
+
 /// An LDraw part file name without its `.dat` extension, e.g. `3001`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 pub struct PartId(pub &'static str);
@@ -101,6 +104,12 @@ impl PartSpec {
             Symmetry::QuarterTurn => Rot::R0,
             Symmetry::HalfTurn => Rot::from_quarter_turns(rot.quarter_turns() % 2),
         }
+    }
+
+    /// Rebrickable's part number: Rebrickable numbers these parts as
+    /// BrickLink does (`3040`, not LDraw's `3040b`).
+    pub fn rebrickable(&self) -> &'static str {
+        self.bricklink
     }
 
     /// Brick, plate or slope.
@@ -439,17 +448,6 @@ pub static PARTS: &[PartSpec] = &[
         1.18
     ),
 ];
-
-/// An LDraw colour code.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-pub struct Color(pub u16);
-
-impl Color {
-    /// LDraw 4, red.
-    pub const RED: Color = Color(4);
-    /// LDraw 71, light bluish grey.
-    pub const LIGHT_BLUISH_GREY: Color = Color(71);
-}
 
 #[cfg(test)]
 mod tests {
