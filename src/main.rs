@@ -106,6 +106,31 @@ enum StepBy {
     Layer,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum ConditionArg {
+    /// New parts.
+    #[value(name = "N", alias = "n")]
+    New,
+    /// Used parts.
+    #[value(name = "U", alias = "u")]
+    Used,
+}
+
+fn parse_color(s: &str) -> Result<brickwright::catalog::Color, String> {
+    brickwright::catalog::Color::parse(s).ok_or_else(|| {
+        format!("unknown colour `{s}` (give an LDraw code, a colour name such as \"light bluish grey\", or bl:ID)")
+    })
+}
+
+fn parse_palette(s: &str) -> Result<brickwright::catalog::Palette, String> {
+    brickwright::catalog::Palette::parse(s)
+        .ok_or_else(|| format!("unknown palette `{s}` (layers, random, or a colour)"))
+}
+
+fn parse_formats(s: &str) -> Result<pipeline::Formats, String> {
+    pipeline::Formats::parse(s)
+}
+
 #[derive(Args)]
 struct BuildArgs {
     /// The mesh file: .obj, .gltf, .glb or .stl.
@@ -144,6 +169,20 @@ struct BuildArgs {
     /// Test a complex rule (several pieces at once) once every K search nodes (the paper: 1 to 5); 0 never.
     #[arg(long, value_name = "K", default_value_t = 0)]
     complex_every: u32,
+    /// Colour every piece this colour: an LDraw code (4), an LDraw or BrickLink name
+    /// ("light bluish grey"), or bl:ID for a BrickLink colour id.
+    #[arg(long, conflicts_with = "palette", value_parser = parse_color)]
+    color: Option<brickwright::catalog::Color>,
+    /// How to colour the pieces: layers (alternating by course), random, or one colour.
+    #[arg(long, default_value = "layers", value_parser = parse_palette)]
+    palette: brickwright::catalog::Palette,
+    /// The condition the BrickLink wanted list asks for: N (new) or U (used); default any.
+    #[arg(long, value_enum)]
+    condition: Option<ConditionArg>,
+    /// The files to write, comma-separated: ldr, bricklink, csv, or all (report.json is
+    /// always written).
+    #[arg(long, default_value = "all", value_parser = parse_formats)]
+    formats: pipeline::Formats,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -197,6 +236,14 @@ fn run_build(a: BuildArgs) -> Result<()> {
         (None, Some(StepBy::Layer)) => StepGrouping::Layer,
         (None, None) => StepGrouping::Auto,
     };
+    opts.palette = a
+        .color
+        .map_or(a.palette, brickwright::catalog::Palette::Single);
+    opts.condition = a.condition.map(|c| match c {
+        ConditionArg::New => brickwright::export::partslist::Condition::New,
+        ConditionArg::Used => brickwright::export::partslist::Condition::Used,
+    });
+    opts.formats = a.formats;
     opts.search = opts
         .search
         .with_seed(a.seed)
@@ -206,16 +253,45 @@ fn run_build(a: BuildArgs) -> Result<()> {
         bar: Default::default(),
     };
     let progress: &dyn Progress = if a.quiet { &Silent } else { &spinners };
+    let opts_out = opts.out_dir.clone();
     let out = pipeline::build(&opts, progress)?;
     if !a.quiet {
         let r = &out.report;
         outln!(
             "{} -> {}: {} pieces in {} steps, {} voxels ({:.1} voxels a piece), {}x{} studs x {} bricks high, verified",
-            r.input, r.outputs[0], r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1],
+            r.input, opts_out.display(), r.pieces, r.steps, r.voxels, r.voxels_per_piece, r.grid[0], r.grid[1],
             fmt_bricks(r.grid[2], r.layer_ldu)
         );
+        outln!(
+            "  {:>5}   {:<6} {:<30} {:<22} BrickLink",
+            "count",
+            "part",
+            "name",
+            "colour"
+        );
         for p in &r.parts {
-            outln!("  {:>5} x {:<6} {}", p.count, p.part, p.name);
+            let bl_color = p.bricklink_color.map_or_else(
+                || "no BrickLink colour".to_string(),
+                |c| format!("colour {c}"),
+            );
+            outln!(
+                "  {:>5} x {:<6} {:<30} {:<22} {} {}",
+                p.count,
+                p.part,
+                p.name,
+                p.color_name,
+                p.bricklink,
+                bl_color
+            );
+        }
+        if !r.unmapped_colors.is_empty() {
+            outln!(
+                "  warning: colours with no known BrickLink or Rebrickable id: {:?}; their parts-list lines say so",
+                r.unmapped_colors
+            );
+        }
+        for f in &r.outputs {
+            outln!("  wrote {f}");
         }
         let rep = &r.repairs;
         if rep.budget_left_out > 0 {

@@ -5,7 +5,6 @@
 //! is written, and writes every output atomically: a failed run leaves no
 //! file behind.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -14,8 +13,11 @@ use thiserror::Error;
 
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, StepGrouping};
-use crate::catalog::{Color, Family};
-use crate::fsutil::write_atomic;
+use crate::catalog::{Color, Family, Palette};
+use crate::export::partslist::{
+    write_bricklink, write_rebrickable_csv, Condition, PartsList, PartsRow,
+};
+use crate::fsutil::Outputs;
 use crate::grammar::{default_rules, RuleError, RuleSet};
 use crate::ldraw::{write_ldr, LdrMeta};
 use crate::mesh::{self, MeshError};
@@ -46,6 +48,98 @@ pub struct BuildOptions {
     pub steps: StepGrouping,
     /// Search tuning, including the seed.
     pub search: SearchOptions,
+    /// How pieces are coloured. Default [`Palette::Layers`].
+    pub palette: Palette,
+    /// The condition the BrickLink wanted list asks for; `None` (the
+    /// default) for any.
+    pub condition: Option<Condition>,
+    /// The files to write besides `report.json`. Default
+    /// [`Formats::default`]: every format but `.gltf`.
+    pub formats: Formats,
+}
+
+/// A file `brickwright build` can write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Format {
+    /// `<stem>.ldr`: the LDraw model, a `0 STEP` per step.
+    Ldr,
+    /// `<stem>-bricklink.xml`: a BrickLink wanted list.
+    Bricklink,
+    /// `<stem>-parts.csv`: a Rebrickable parts list.
+    Csv,
+}
+
+impl Format {
+    /// Every format, in the order files are written.
+    pub const ALL: [Format; 3] = [Format::Ldr, Format::Bricklink, Format::Csv];
+
+    /// The name `--formats` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Ldr => "ldr",
+            Format::Bricklink => "bricklink",
+            Format::Csv => "csv",
+        }
+    }
+
+    /// The file this format writes for a model named `stem`.
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Format::Ldr => format!("{stem}.ldr"),
+            Format::Bricklink => format!("{stem}-bricklink.xml"),
+            Format::Csv => format!("{stem}-parts.csv"),
+        }
+    }
+}
+
+/// A set of [`Format`]s.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Formats(Vec<Format>);
+
+impl Default for Formats {
+    /// Every format.
+    fn default() -> Self {
+        Formats(Format::ALL.to_vec())
+    }
+}
+
+impl Formats {
+    /// Formats from a comma-separated list of names (`ldr,bricklink`), or
+    /// `all`. The error names the unknown format and the known ones.
+    pub fn parse(s: &str) -> Result<Formats, String> {
+        let mut set = Vec::new();
+        for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+            if name == "all" {
+                set.extend(Format::ALL);
+                continue;
+            }
+            let f = Format::ALL
+                .into_iter()
+                .find(|f| f.name() == name)
+                .ok_or_else(|| {
+                    let known: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+                    format!("unknown format `{name}` (known: {}, all)", known.join(", "))
+                })?;
+            set.push(f);
+        }
+        if set.is_empty() {
+            return Err("no format given (known: ldr, bricklink, csv, all)".into());
+        }
+        set.sort_unstable();
+        set.dedup();
+        Ok(Formats(set))
+    }
+
+    /// Whether `f` is in the set.
+    pub fn contains(&self, f: Format) -> bool {
+        self.0.contains(&f)
+    }
+
+    /// The formats, in writing order.
+    pub fn iter(&self) -> impl Iterator<Item = Format> + '_ {
+        self.0.iter().copied()
+    }
 }
 
 impl BuildOptions {
@@ -61,6 +155,9 @@ impl BuildOptions {
             plates: false,
             steps: StepGrouping::Auto,
             search: SearchOptions::default(),
+            palette: Palette::default(),
+            condition: None,
+            formats: Formats::default(),
         }
     }
 }
@@ -108,17 +205,6 @@ pub enum BuildError {
     },
 }
 
-/// One line of the parts table.
-#[derive(Debug, Clone, Serialize)]
-pub struct PartCount {
-    /// LDraw id.
-    pub part: String,
-    /// Part name.
-    pub name: String,
-    /// How many.
-    pub count: usize,
-}
-
 /// Seconds spent in each stage.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct StageTimes {
@@ -162,8 +248,11 @@ pub struct BuildReport {
     pub voxels_per_piece: f64,
     /// Vertical seams and how many continue into the course above.
     pub seams: crate::assembly::metrics::SeamStats,
-    /// Pieces by part.
-    pub parts: Vec<PartCount>,
+    /// Pieces by part and colour, with their BrickLink and Rebrickable ids.
+    pub parts: Vec<PartsRow>,
+    /// LDraw colours of the build that have no known BrickLink or
+    /// Rebrickable id (their parts-list lines say so).
+    pub unmapped_colors: Vec<u16>,
     /// Connected components of the finished build (1 when verified).
     pub components: usize,
     /// Steps in the outputs.
@@ -199,6 +288,12 @@ pub struct ReportOptions {
     pub slopes: bool,
     /// Whether plates were allowed.
     pub plates: bool,
+    /// The palette: `layers`, `random`, or an LDraw colour code.
+    pub palette: String,
+    /// The wanted list's condition: `N`, `U`, or `any`.
+    pub condition: String,
+    /// The files asked for.
+    pub formats: Formats,
 }
 
 /// Stage callbacks, for progress display.
@@ -286,12 +381,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let t = Instant::now();
     let order = search::placements(&outcome);
     let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
-    let palette = [Color::RED, Color(15)];
-    for p in &mut assembly.pieces {
-        // Alternate colours by brick course, so the structure reads.
-        let course = p.placement.origin.z * rules.layer_ldu() / 24;
-        p.color = palette[course as usize % palette.len()];
-    }
+    assembly.paint(opts.palette, opts.search.seed);
     let check = verify(&assembly, Some(&outcome.voxels));
     if !check.is_ok() {
         return Err(BuildError::Unverified {
@@ -314,7 +404,6 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "model".into());
-    let ldr_path = opts.out_dir.join(format!("{stem}.ldr"));
     let report_path = opts.out_dir.join("report.json");
     let meta = LdrMeta {
         title: format!("{stem}, built by brickwright"),
@@ -334,18 +423,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         ],
     };
     let (nx, ny, nz) = outcome.voxels.dims();
-    let mut parts: BTreeMap<String, PartCount> = BTreeMap::new();
-    for (kind, count) in assembly.counts_by_part() {
-        let spec = kind.spec();
-        parts.insert(
-            spec.id.0.to_string(),
-            PartCount {
-                part: spec.id.0.to_string(),
-                name: spec.name.to_string(),
-                count,
-            },
-        );
-    }
+    let parts = PartsList::of(&assembly);
     let pieces = assembly.pieces.len();
     let voxels = outcome.voxels.count();
     let mut report = BuildReport {
@@ -369,6 +447,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             time_budget: opts.search.time_budget.as_secs_f64(),
             slopes: opts.slopes,
             plates: opts.plates,
+            palette: opts.palette.describe(),
+            condition: match opts.condition {
+                Some(Condition::New) => "N".into(),
+                Some(Condition::Used) => "U".into(),
+                None => "any".into(),
+            },
+            formats: opts.formats.clone(),
         },
         triangles: mesh.triangles.len(),
         grid: [nx, ny, nz],
@@ -378,7 +463,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         pieces,
         voxels_per_piece: ((voxels as f64 / pieces.max(1) as f64) * 100.0).round() / 100.0,
         seams: crate::assembly::metrics::seams(&assembly),
-        parts: parts.into_values().collect(),
+        parts: parts.rows(),
+        unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: 1,
         steps: assembly.step_count(),
         size_cm: [
@@ -389,24 +475,40 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         seconds: times,
         search: outcome.stats.clone(),
         repairs: outcome.repairs.clone(),
-        outputs: vec![
-            ldr_path.display().to_string(),
-            report_path.display().to_string(),
-        ],
+        outputs: Vec::new(),
     };
-    write_atomic(&ldr_path, |w| write_ldr(w, &assembly, &meta)).map_err(|reason| {
-        BuildError::Write {
-            path: ldr_path.display().to_string(),
+    // Every file is staged first and renamed into place together, so a
+    // failed run leaves none of them.
+    let mut files = Outputs::new();
+    for format in opts.formats.iter() {
+        let path = opts.out_dir.join(format.file_name(&stem));
+        let written = match format {
+            Format::Ldr => files.add(&path, |w| write_ldr(w, &assembly, &meta)),
+            Format::Bricklink => files.add(&path, |w| write_bricklink(w, &parts, opts.condition)),
+            Format::Csv => files.add(&path, |w| write_rebrickable_csv(w, &parts)),
+        };
+        written.map_err(|reason| BuildError::Write {
+            path: path.display().to_string(),
             reason,
-        }
-    })?;
+        })?;
+    }
+    report.outputs = files
+        .paths()
+        .chain([report_path.as_path()])
+        .map(|p| p.display().to_string())
+        .collect();
     report.seconds.write = secs(t);
-    write_atomic(&report_path, |w| {
-        serde_json::to_writer_pretty(&mut *w, &report).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")
-    })
-    .map_err(|reason| BuildError::Write {
-        path: report_path.display().to_string(),
+    files
+        .add(&report_path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &report).map_err(std::io::Error::other)?;
+            w.write_all(b"\n")
+        })
+        .map_err(|reason| BuildError::Write {
+            path: report_path.display().to_string(),
+            reason,
+        })?;
+    files.commit().map_err(|(path, reason)| BuildError::Write {
+        path: path.display().to_string(),
         reason,
     })?;
     progress.done();
@@ -452,8 +554,12 @@ fn describe(opts: &BuildOptions) -> String {
     };
     let slopes = if opts.slopes { " --slopes" } else { "" };
     let plates = if opts.plates { " --plates" } else { "" };
+    let palette = match opts.palette {
+        Palette::Layers => String::new(),
+        p => format!(" --palette {}", p.describe()),
+    };
     format!(
-        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}",
+        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}{palette}",
         opts.search.seed
     )
 }

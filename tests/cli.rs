@@ -144,15 +144,30 @@ fn build_and_verify(name: &str) {
     let stem = Path::new(name).file_stem().unwrap().to_str().unwrap();
     let ldr = out.join(format!("{stem}.ldr"));
     assert!(ldr.is_file(), "{} was not written", ldr.display());
-    let mut expected = vec![ldr.clone(), out.join("report.json")];
+    let report = read_report(&out);
+    let mut expected: Vec<PathBuf> = ["ldr", "-bricklink.xml", "-parts.csv"]
+        .iter()
+        .map(|suffix| match *suffix {
+            "ldr" => ldr.clone(),
+            _ => out.join(format!("{stem}{suffix}")),
+        })
+        .chain([out.join("report.json")])
+        .collect();
     expected.sort();
     assert_eq!(
         files_under(tmp.path()),
         expected,
-        "exactly the .ldr and report.json, nothing else"
+        "exactly the default outputs and report.json, nothing else"
     );
+    let mut listed: Vec<PathBuf> = report["outputs"]
+        .as_array()
+        .expect("outputs list")
+        .iter()
+        .map(|p| PathBuf::from(p.as_str().unwrap()))
+        .collect();
+    listed.sort();
+    assert_eq!(listed, expected, "report.json lists what was written");
 
-    let report = read_report(&out);
     assert_eq!(report_u64(&report, "components"), 1, "{report}");
     let pieces = report_u64(&report, "pieces");
     assert!(pieces > 0, "{report}");
@@ -460,6 +475,12 @@ fn bad_options_fail_without_a_panic() {
         &["--step-size", "0"],
         &["--up", "x"],
         &["--complex-every", "-1"],
+        &["--formats", "ldr,pdfx"],
+        &["--formats", ""],
+        &["--color", "chartreuse"],
+        &["--palette", "stripes"],
+        &["--condition", "Q"],
+        &["--color", "red", "--palette", "random"],
     ] {
         let tmp = tempdir();
         let out = tmp.path().join("out");
@@ -483,6 +504,53 @@ fn bad_options_fail_without_a_panic() {
 }
 
 const BRICK: &str = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat";
+
+#[test]
+fn colour_condition_and_formats_reach_the_files() {
+    let tmp = tempdir();
+    let out = tmp.path().join("out");
+    let run = build(
+        tmp.path(),
+        &fixture("box.obj"),
+        &out,
+        &[
+            "--color",
+            "light bluish gray",
+            "--condition",
+            "U",
+            "--formats",
+            "ldr,bricklink",
+        ],
+    );
+    run.assert_ok();
+    let names: Vec<String> = files_under(&out)
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["box-bricklink.xml", "box.ldr", "report.json"]);
+    let ldr = std::fs::read_to_string(out.join("box.ldr")).unwrap();
+    assert!(ldr
+        .lines()
+        .filter(|l| l.starts_with("1 "))
+        .all(|l| l.starts_with("1 71 ")));
+    let xml = std::fs::read_to_string(out.join("box-bricklink.xml")).unwrap();
+    assert!(xml.contains("<COLOR>86</COLOR>") && xml.contains("<CONDITION>U</CONDITION>"));
+    assert!(!xml.contains("<COLOR>5</COLOR>"));
+    let report = read_report(&out);
+    assert_eq!(report["options"]["palette"], "71");
+    assert_eq!(report["options"]["condition"], "U");
+    // Without --quiet, the summary prints the parts table with shop ids.
+    let (out2, input) = (tmp.path().join("out2"), fixture("box.obj"));
+    let mut args = vec!["build", s(&input), "-o", s(&out2)];
+    args.extend_from_slice(&["--studs", "10", "--color", "71"]);
+    let run = run_in(tmp.path(), &args);
+    run.assert_ok();
+    assert!(
+        run.stdout.contains("Light Bluish Grey") && run.stdout.contains("colour 86"),
+        "{}",
+        run.describe()
+    );
+}
 
 #[test]
 fn verify_finds_overlaps_and_floating_bricks() {

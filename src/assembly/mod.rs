@@ -9,7 +9,10 @@ pub mod verify;
 
 use serde::Serialize;
 
-use crate::catalog::{Color, PartKind};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::catalog::{Color, Palette, PartKind, LAYER_PALETTE, RANDOM_PALETTE};
 use crate::geom::{Body, Cell, Rot};
 
 /// A building step number, counted from 1.
@@ -117,6 +120,24 @@ impl Assembly {
         }
     }
 
+    /// Colours every piece by `palette`; `seed` drives
+    /// [`Palette::Random`], so the same seed gives the same colours.
+    pub fn paint(&mut self, palette: Palette, seed: u64) {
+        let layer_ldu = self.layer_ldu;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for p in &mut self.pieces {
+            p.color = match palette {
+                Palette::Single(c) => c,
+                Palette::Random => RANDOM_PALETTE[rng.gen_range(0..RANDOM_PALETTE.len())],
+                Palette::Layers => {
+                    // By brick course (24 LDU), whatever the layer height.
+                    let course = (p.placement.origin.z * layer_ldu).div_euclid(24);
+                    LAYER_PALETTE[course.rem_euclid(LAYER_PALETTE.len() as i32) as usize]
+                }
+            };
+        }
+    }
+
     /// Pieces counted by part, in catalog order.
     pub fn counts_by_part(&self) -> Vec<(PartKind, usize)> {
         let mut counts = std::collections::BTreeMap::new();
@@ -172,5 +193,24 @@ mod tests {
         let mut layers = assembly(9);
         layers.regroup(StepGrouping::Layer);
         assert_eq!(layers.step_count(), 3);
+    }
+
+    #[test]
+    fn palettes_paint_by_layer_at_random_or_all_alike() {
+        let mut a = assembly(9);
+        a.paint(Palette::Layers, 1);
+        let colors: Vec<u16> = a.pieces.iter().map(|p| p.color.0).collect();
+        assert_eq!(colors, [4, 4, 4, 15, 15, 15, 4, 4, 4]);
+        a.paint(Palette::Single(Color(1)), 1);
+        assert!(a.pieces.iter().all(|p| p.color == Color(1)));
+        let mut b = assembly(200);
+        b.paint(Palette::Random, 7);
+        let mut c = b.clone();
+        c.paint(Palette::Random, 7);
+        assert_eq!(b, c);
+        let distinct: std::collections::BTreeSet<_> = b.pieces.iter().map(|p| p.color).collect();
+        assert_eq!(distinct.len(), RANDOM_PALETTE.len());
+        c.paint(Palette::Random, 8);
+        assert_ne!(b, c);
     }
 }

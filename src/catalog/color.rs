@@ -200,7 +200,8 @@ fn normalize(s: &str) -> String {
 }
 
 /// How a build's pieces are coloured.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Palette {
     /// Every piece one colour.
     Single(Color),
