@@ -1,0 +1,10 @@
+//! Exporters that draw the build: part meshes and glTF 2.0 scenes.
+//!
+//! Everything here reads only the [`Assembly`](crate::assembly::Assembly)
+//! and the parts catalog, never voxels or rules.
+//!
+//! - [`partmesh`] gives every part type a closed triangle mesh in its own
+//!   LDraw frame, and every piece the affine map that places it exactly as
+//!   the `.ldr` does.
+
+pub mod partmesh;
