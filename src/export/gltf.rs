@@ -238,11 +238,17 @@ fn sane(v: f32, min: f32, fallback: f32) -> f32 {
     }
 }
 
-/// Writes `assembly` as a glTF 2.0 scene to `w`.
+/// Writes `assembly` as a glTF 2.0 scene to `w` (any writer, also a
+/// `&mut dyn Write` such as [`write_atomic`](crate::fsutil::write_atomic)
+/// hands out).
 ///
 /// Fails only when `w` fails, or (as [`io::ErrorKind::InvalidData`]) when a
 /// binary file would pass the 4 GiB a `.glb` can hold.
-pub fn write_gltf(w: &mut impl Write, assembly: &Assembly, opts: &GltfOptions) -> io::Result<()> {
+pub fn write_gltf<W: Write + ?Sized>(
+    w: &mut W,
+    assembly: &Assembly,
+    opts: &GltfOptions,
+) -> io::Result<()> {
     let (root, bin) = document(assembly, opts);
     match opts.container {
         Container::Binary => write_glb(w, &root, &bin),
@@ -258,7 +264,7 @@ pub fn write_gltf(w: &mut impl Write, assembly: &Assembly, opts: &GltfOptions) -
     }
 }
 
-fn write_glb(w: &mut impl Write, root: &Root, bin: &[u8]) -> io::Result<()> {
+fn write_glb<W: Write + ?Sized>(w: &mut W, root: &Root, bin: &[u8]) -> io::Result<()> {
     let mut json = serde_json::to_vec(root).map_err(io::Error::other)?;
     while json.len() % 4 != 0 {
         json.push(b' ');
