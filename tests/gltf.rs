@@ -54,19 +54,14 @@ fn ldr_steps(text: &str) -> Vec<u32> {
 
 /// The node_modules directory holding `gltf-validator`, if any.
 fn validator_path() -> Option<PathBuf> {
-    let candidates = std::env::var_os("GLTF_VALIDATOR_NODE_PATH")
+    let mut candidates = std::env::var_os("GLTF_VALIDATOR_NODE_PATH")
         .map(PathBuf::from)
         .into_iter()
         .chain([
             Path::new(env!("CARGO_MANIFEST_DIR")).join("node_modules"),
             PathBuf::from("/tmp/gv/node_modules"),
         ]);
-    for dir in candidates {
-        if dir.join("gltf-validator").is_dir() {
-            return Some(dir);
-        }
-    }
-    None
+    candidates.find(|dir| dir.join("gltf-validator").is_dir())
 }
 
 /// Runs the Khronos validator on `files`; panics on any error. Skips (or
