@@ -18,6 +18,7 @@
 //! - [`assembly`] is the ordered build every exporter reads, with an
 //!   independent verifier.
 //! - [`ldraw`] writes (and reads back) LDraw `.ldr` files.
+//! - [`export`] draws the build: part meshes, exploded views, glTF 2.0.
 //! - [`pipeline`] ties the stages together for the command-line tool.
 
 pub mod assembly;
