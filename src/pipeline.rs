@@ -43,8 +43,8 @@ pub struct BuildOptions {
     pub slopes: bool,
     /// Build with plates too (layers a plate high). Default off.
     pub plates: bool,
-    /// Step grouping in the outputs. Default one piece a step, grouped
-    /// further past 255 steps.
+    /// Step grouping in all outputs. Default [`StepGrouping::Auto`]: by
+    /// course, at most 8 pieces a step.
     pub steps: StepGrouping,
     /// Search tuning, including the seed.
     pub search: SearchOptions,
@@ -517,7 +517,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
 fn step_name(s: StepGrouping) -> String {
     match s {
-        StepGrouping::Auto => "one piece a step, at most 255 steps".into(),
+        StepGrouping::Auto => "by course, at most 8 pieces a step (more past 255 steps)".into(),
         StepGrouping::Each => "one piece a step".into(),
         StepGrouping::Size(n) => format!("{n} pieces a step"),
         StepGrouping::Layer => "by layer".into(),

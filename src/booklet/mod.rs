@@ -27,8 +27,8 @@ use std::io::{self, Write};
 
 use image::RgbaImage;
 use printpdf::{
-    BuiltinFont, Color as PdfColor, Line, LinePoint, Mm, Op, ParsedFont, PdfDocument,
-    PdfFontHandle, PdfPage, PaintMode, PdfSaveOptions, Point, Pt, RawImage, RawImageData, RawImageFormat,
+    BuiltinFont, Color as PdfColor, Line, LinePoint, Mm, Op, PaintMode, ParsedFont, PdfDocument,
+    PdfFontHandle, PdfPage, PdfSaveOptions, Point, Pt, RawImage, RawImageData, RawImageFormat,
     Rect, Rgb as PdfRgb, TextItem, XObject, XObjectId, XObjectTransform,
 };
 
@@ -109,7 +109,9 @@ fn callout_capacity(share: Share, content_w: f32) -> usize {
         Share::Quarter => content_w / 2.0,
         Share::Half | Share::Full => content_w,
     };
-    let per_row = ((cell_w - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W).floor().max(1.0) as usize;
+    let per_row = ((cell_w - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W)
+        .floor()
+        .max(1.0) as usize;
     per_row * if share == Share::Full { 3 } else { 2 }
 }
 
@@ -236,7 +238,9 @@ impl PageOps {
         let pos = self.point(x, y);
         self.ops.extend([
             Op::StartTextSection,
-            Op::SetFillColor { col: pdf_rgb(color) },
+            Op::SetFillColor {
+                col: pdf_rgb(color),
+            },
             Op::SetFont {
                 font: PdfFontHandle::Builtin(font),
                 size: Pt(size),
@@ -253,7 +257,9 @@ impl PageOps {
     fn fill(&mut self, x: f32, y: f32, w: f32, h: f32, color: Rgb) {
         let ll = self.point(x, y + h);
         self.ops.extend([
-            Op::SetFillColor { col: pdf_rgb(color) },
+            Op::SetFillColor {
+                col: pdf_rgb(color),
+            },
             Op::DrawRectangle {
                 rectangle: Rect {
                     mode: Some(PaintMode::Fill),
@@ -267,13 +273,21 @@ impl PageOps {
     fn rule(&mut self, x0: f32, x1: f32, y: f32, color: Rgb) {
         let (a, b) = (self.point(x0, y), self.point(x1, y));
         self.ops.extend([
-            Op::SetOutlineColor { col: pdf_rgb(color) },
+            Op::SetOutlineColor {
+                col: pdf_rgb(color),
+            },
             Op::SetOutlineThickness { pt: Pt(0.5) },
             Op::DrawLine {
                 line: Line {
                     points: vec![
-                        LinePoint { p: a, bezier: false },
-                        LinePoint { p: b, bezier: false },
+                        LinePoint {
+                            p: a,
+                            bezier: false,
+                        },
+                        LinePoint {
+                            p: b,
+                            bezier: false,
+                        },
                     ],
                     is_closed: false,
                 },
@@ -366,7 +380,9 @@ pub fn write_booklet<W: Write + ?Sized>(
 /// exploded view.
 pub fn page_count(input: &BookletInput<'_>, template: &Template) -> usize {
     let lines: Vec<usize> = step_parts(input.assembly).iter().map(Vec::len).collect();
-    1 + bom_pages(bom_lines(input.assembly).len(), template) + plan_steps(&lines, template).len() + 1
+    1 + bom_pages(bom_lines(input.assembly).len(), template)
+        + plan_steps(&lines, template).len()
+        + 1
 }
 
 fn bom_lines(assembly: &Assembly) -> Vec<(PartKind, Color, usize)> {
@@ -492,7 +508,15 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                 .spec()
                 .map_or_else(|| "no BrickLink colour".into(), |c| c.bricklink.to_string());
             let mut ly = y + 22.0 + ts * 0.3528 + 2.0;
-            page.text(&fonts, x + 2.0, ly, ts * 1.3, true, text, &format!("{count}x"));
+            page.text(
+                &fonts,
+                x + 2.0,
+                ly,
+                ts * 1.3,
+                true,
+                text,
+                &format!("{count}x"),
+            );
             ly += ts * 0.3528 * 1.3 + 1.5;
             for (l, s) in [
                 spec.name.to_string(),
@@ -528,7 +552,15 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
             }
             let ns = t.fonts.step_number_size;
             let label = step.to_string();
-            page.text(&fonts, x + 1.0, y + ns * 0.3528, ns, true, t.colors.accent, &label);
+            page.text(
+                &fonts,
+                x + 1.0,
+                y + ns * 0.3528,
+                ns,
+                true,
+                t.colors.accent,
+                &label,
+            );
             // Parts-needed callout to the right of the number.
             let items = &steps[step as usize - 1];
             let cx = x + fonts.width(&label, ns, true) + 5.0;
@@ -569,7 +601,15 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     // Exploded view.
     let mut page = PageOps::new(ph);
     let hs = t.fonts.heading_size;
-    page.text(&fonts, m, m + hs * 0.3528, hs, true, t.colors.accent, "Exploded view");
+    page.text(
+        &fonts,
+        m,
+        m + hs * 0.3528,
+        hs,
+        true,
+        t.colors.accent,
+        "Exploded view",
+    );
     let ex = add_image(&mut doc, &mut n, input.exploded);
     let top = m + hs * 0.3528 + 6.0;
     page.image(&ex, m, top, cw, ch - (top - m) - 4.0);
@@ -625,7 +665,10 @@ mod tests {
                 .entry((p.placement.part, p.color))
                 .or_insert_with(|| picture(64, 64, p.color.rgb()));
         }
-        let (model, exploded) = (picture(200, 150, [90, 90, 200]), picture(150, 200, [90, 200, 90]));
+        let (model, exploded) = (
+            picture(200, 150, [90, 90, 200]),
+            picture(150, 200, [90, 200, 90]),
+        );
         let input = BookletInput {
             title: "wall",
             assembly: &a,
@@ -661,8 +704,7 @@ mod tests {
         let t = Template::default();
         // Quarter cells hold 2 rows of 4 items on A4 with 12 mm margins.
         let plan = plan_steps(&[1, 2, 1, 3, 1, 12, 1, 1, 30], &t);
-        let shares: Vec<(Share, Vec<u32>)> =
-            plan.into_iter().map(|p| (p.share, p.steps)).collect();
+        let shares: Vec<(Share, Vec<u32>)> = plan.into_iter().map(|p| (p.share, p.steps)).collect();
         assert_eq!(
             shares,
             [

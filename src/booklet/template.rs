@@ -240,9 +240,9 @@ impl Template {
             };
             invalid(line, message)
         })?;
-        template.check().map_err(|(key, message)| {
-            invalid(line_of_key(text, key), message)
-        })?;
+        template
+            .check()
+            .map_err(|(key, message)| invalid(line_of_key(text, key), message))?;
         Ok(template)
     }
 
@@ -317,7 +317,11 @@ mod tests {
             ("[steps]\nper_page = 3\n", 2, "per_page"),
             ("[fonts]\n\ntext_size = 1.0\n", 3, "text_size"),
             ("[colors]\naccent = \"red\"\n", 2, "#B40000"),
-            ("[page]\nsize = \"A4\"\npaper = 1\n", 3, "unknown key `paper`"),
+            (
+                "[page]\nsize = \"A4\"\npaper = 1\n",
+                3,
+                "unknown key `paper`",
+            ),
             ("[cover]\ntitle = 1\n", 1, "unknown section `cover`"),
             ("[page\nsize = 1\n", 1, ""),
             ("[page]\nmargin = \"wide\"\n", 2, ""),
@@ -331,6 +335,8 @@ mod tests {
             assert_eq!(err.lines().count(), 1, "{err}");
         }
         let err = Template::load(Path::new("/no/such/template.toml")).unwrap_err();
-        assert!(err.to_string().starts_with("/no/such/template.toml: cannot read"));
+        assert!(err
+            .to_string()
+            .starts_with("/no/such/template.toml: cannot read"));
     }
 }
