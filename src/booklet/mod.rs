@@ -233,7 +233,8 @@ impl PageOps {
     }
 
     /// Text with its baseline at `y`.
-    fn text(&mut self, fonts: &Fonts, x: f32, y: f32, size: f32, bold: bool, color: Rgb, s: &str) {
+    fn text(&mut self, fonts: &Fonts, x: f32, y: f32, style: (f32, bool, Rgb), s: &str) {
+        let (size, bold, color) = style;
         let font = if bold { fonts.bold } else { fonts.regular };
         let pos = self.point(x, y);
         self.ops.extend([
@@ -434,7 +435,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         if numbered {
             let label = number.to_string();
             let x = pw / 2.0 - fonts.width(&label, ts, false) / 2.0;
-            page.text(&fonts, x, ph - m / 2.0, ts, false, text, &label);
+            page.text(&fonts, x, ph - m / 2.0, (ts, false, text), &label);
         }
         number += 1;
         pages.push(PdfPage::new(Mm(pw), Mm(ph), page.ops));
@@ -448,9 +449,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         &fonts,
         (pw - title_w).max(0.0) / 2.0,
         m + title_size * 0.3528,
-        title_size,
-        true,
-        t.colors.accent,
+        (title_size, true, t.colors.accent),
         input.title,
     );
     let model = add_image(&mut doc, &mut n, input.model);
@@ -472,7 +471,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
             ts * 1.4
         };
         let wd = fonts.width(l, size, i == 0);
-        page.text(&fonts, (pw - wd) / 2.0, y, size, i == 0, text, l);
+        page.text(&fonts, (pw - wd) / 2.0, y, (size, i == 0, text), l);
         y += size * 0.3528 + 3.0;
     }
     finish(page, &mut pages, false);
@@ -491,10 +490,10 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         let mut page = PageOps::new(ph);
         let hs = t.fonts.heading_size;
         let head_y = m + hs * 0.3528;
-        page.text(&fonts, m, head_y, hs, true, t.colors.accent, "Parts list");
+        page.text(&fonts, m, head_y, (hs, true, t.colors.accent), "Parts list");
         let total = format!("{pieces} pieces, {} kinds", bom.len());
         let tw = fonts.width(&total, ts, false);
-        page.text(&fonts, pw - m - tw, head_y, ts, false, text, &total);
+        page.text(&fonts, pw - m - tw, head_y, (ts, false, text), &total);
         page.rule(m, pw - m, head_y + 3.0, t.colors.rule);
         for (i, &(part, color, count)) in chunk.iter().enumerate() {
             let (col, row) = (i % BOM_COLUMNS, i / BOM_COLUMNS);
@@ -512,9 +511,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                 &fonts,
                 x + 2.0,
                 ly,
-                ts * 1.3,
-                true,
-                text,
+                (ts * 1.3, true, text),
                 &format!("{count}x"),
             );
             ly += ts * 0.3528 * 1.3 + 1.5;
@@ -528,7 +525,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
             .enumerate()
             {
                 let size = if l == 0 { ts } else { ts * 0.85 };
-                page.text(&fonts, x + 2.0, ly, size, false, text, s);
+                page.text(&fonts, x + 2.0, ly, (size, false, text), s);
                 ly += size * 0.3528 + 1.2;
             }
         }
@@ -556,9 +553,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                 &fonts,
                 x + 1.0,
                 y + ns * 0.3528,
-                ns,
-                true,
-                t.colors.accent,
+                (ns, true, t.colors.accent),
                 &label,
             );
             // Parts-needed callout to the right of the number.
@@ -585,9 +580,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                     &fonts,
                     ix + 1.0,
                     iy + CALLOUT_PICTURE + ts * 0.3528 + 1.0,
-                    ts,
-                    true,
-                    text,
+                    (ts, true, text),
                     &label,
                 );
             }
@@ -605,9 +598,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         &fonts,
         m,
         m + hs * 0.3528,
-        hs,
-        true,
-        t.colors.accent,
+        (hs, true, t.colors.accent),
         "Exploded view",
     );
     let ex = add_image(&mut doc, &mut n, input.exploded);
