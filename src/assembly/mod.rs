@@ -5,6 +5,7 @@
 //! independent [`verify`] module before anything is written.
 
 pub mod metrics;
+pub mod order;
 pub mod verify;
 
 use serde::Serialize;
