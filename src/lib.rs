@@ -22,6 +22,7 @@
 //! - [`pipeline`] ties the stages together for the command-line tool.
 
 pub mod assembly;
+pub mod booklet;
 pub mod catalog;
 pub mod export;
 pub mod fsutil;

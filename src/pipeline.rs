@@ -43,8 +43,8 @@ pub struct BuildOptions {
     pub slopes: bool,
     /// Build with plates too (layers a plate high). Default off.
     pub plates: bool,
-    /// Step grouping in the outputs. Default one piece a step, grouped
-    /// further past 255 steps.
+    /// Step grouping in all outputs. Default [`StepGrouping::Auto`]: by
+    /// course, at most 8 pieces a step.
     pub steps: StepGrouping,
     /// Search tuning, including the seed.
     pub search: SearchOptions,
@@ -257,6 +257,10 @@ pub struct BuildReport {
     pub components: usize,
     /// Steps in the outputs.
     pub steps: u32,
+    /// The build order: `by course` (the search's pieces re-sequenced
+    /// course by course, verified) or `search trace` (when the
+    /// re-sequenced order did not verify).
+    pub order: String,
     /// Size of the finished model, centimetres (x, y, height).
     pub size_cm: [f64; 3],
     /// Seconds per stage.
@@ -389,6 +393,15 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             report: check.to_string(),
         });
     }
+    // Re-sequence course by course so steps read like instructions; keep
+    // the search's order if the re-sequenced one does not verify.
+    let by_course = crate::assembly::order::by_course(&assembly);
+    let order_name = if verify(&by_course, Some(&outcome.voxels)).is_ok() {
+        assembly = by_course;
+        "by course"
+    } else {
+        "search trace"
+    };
     assembly.regroup(opts.steps);
     times.verify = secs(t);
     progress.done();
@@ -467,6 +480,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: 1,
         steps: assembly.step_count(),
+        order: order_name.into(),
         size_cm: [
             nx as f64 * 0.8,
             ny as f64 * 0.8,
@@ -517,7 +531,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
 fn step_name(s: StepGrouping) -> String {
     match s {
-        StepGrouping::Auto => "one piece a step, at most 255 steps".into(),
+        StepGrouping::Auto => "by course, at most 8 pieces a step (more past 255 steps)".into(),
         StepGrouping::Each => "one piece a step".into(),
         StepGrouping::Size(n) => format!("{n} pieces a step"),
         StepGrouping::Layer => "by layer".into(),

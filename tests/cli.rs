@@ -373,7 +373,23 @@ fn ldr_header_and_steps_match_the_report() {
     let report = read_report(&out);
     let pieces = report_u64(&report, "pieces");
     assert_eq!(count_steps(&text) as u64, report_u64(&report, "steps"));
-    assert_eq!(report_u64(&report, "steps"), pieces, "one piece a step");
+    // By default a step holds at most 8 pieces, all on one course (the
+    // same LDraw Y for bricks).
+    let steps: Vec<Vec<&str>> = text
+        .split("0 STEP")
+        .map(|chunk| chunk.lines().filter(|l| l.starts_with("1 ")).collect())
+        .filter(|lines: &Vec<&str>| !lines.is_empty())
+        .collect();
+    assert_eq!(steps.len() as u64, report_u64(&report, "steps"));
+    for step in &steps {
+        assert!((1..=8).contains(&step.len()), "{step:?}");
+        let ys: std::collections::BTreeSet<&str> = step
+            .iter()
+            .map(|l| l.split_whitespace().nth(3).unwrap())
+            .collect();
+        assert_eq!(ys.len(), 1, "one course a step: {step:?}");
+    }
+    assert!(steps.len() as u64 >= pieces.div_ceil(8));
     assert!(
         text.trim_end().ends_with("0 STEP"),
         "the last step is closed"

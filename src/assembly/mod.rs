@@ -5,6 +5,7 @@
 //! independent [`verify`] module before anything is written.
 
 pub mod metrics;
+pub mod order;
 pub mod verify;
 
 use serde::Serialize;
@@ -90,33 +91,64 @@ impl Assembly {
         self.pieces.last().map_or(0, |p| p.step.0)
     }
 
-    /// Regroups the steps: `StepGrouping::Each` one piece a step,
-    /// `Size(n)` n pieces a step, `Layer` one step per layer run.
+    /// Regroups the steps. `Auto` (the default) makes a step of each run
+    /// of pieces on one brick course, a big run split into balanced steps
+    /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep
+    /// within [`MAX_STEPS`]; `Each` one piece a step; `Size(n)` n pieces a
+    /// step; `Layer` one step per course run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
-        let grouping = match grouping {
-            StepGrouping::Auto if self.pieces.len() <= MAX_STEPS => StepGrouping::Each,
-            StepGrouping::Auto => StepGrouping::Size(self.pieces.len().div_ceil(MAX_STEPS)),
-            g => g,
-        };
-        let mut step = 0u32;
-        let mut in_step = 0usize;
-        let mut last_z = i32::MIN;
-        // Layers by brick course (24 LDU), whatever the grid's layer height.
         let layer_ldu = self.layer_ldu;
-        let course = |p: &Placed| p.placement.origin.z * layer_ldu / 24;
-        for p in &mut self.pieces {
-            let new_step = match grouping {
-                StepGrouping::Each | StepGrouping::Auto => true,
-                StepGrouping::Size(n) => in_step >= n.max(1),
-                StepGrouping::Layer => course(p) != last_z,
-            };
-            if new_step || step == 0 {
-                step += 1;
-                in_step = 0;
+        // Courses by brick height (24 LDU), whatever the grid's layer height.
+        let course = |p: &Placed| (p.placement.origin.z * layer_ldu).div_euclid(24);
+        let mut runs: Vec<usize> = Vec::new();
+        let mut last = None;
+        for p in &self.pieces {
+            let c = course(p);
+            match runs.last_mut() {
+                Some(n) if last == Some(c) => *n += 1,
+                _ => runs.push(1),
             }
-            in_step += 1;
-            last_z = course(p);
-            p.step = Step(step);
+            last = Some(c);
+        }
+        let sizes: Vec<usize> = match grouping {
+            StepGrouping::Each => vec![1; self.pieces.len()],
+            StepGrouping::Size(n) => {
+                let n = n.max(1);
+                let len = self.pieces.len();
+                (0..len.div_ceil(n)).map(|i| n.min(len - i * n)).collect()
+            }
+            StepGrouping::Layer => runs,
+            StepGrouping::Auto => {
+                let split = |cap: usize| -> Vec<usize> {
+                    runs.iter()
+                        .flat_map(|&n| {
+                            let k = n.div_ceil(cap);
+                            // Balanced: sizes differ by at most one.
+                            (0..k).map(move |i| n / k + usize::from(i < n % k))
+                        })
+                        .collect()
+                };
+                let mut cap = STEP_PIECES;
+                let mut sizes = split(cap);
+                while sizes.len() > MAX_STEPS && cap < self.pieces.len() {
+                    cap += 1;
+                    sizes = split(cap);
+                }
+                if sizes.len() > MAX_STEPS {
+                    // More course runs than LeoCAD shows: merge runs.
+                    let n = self.pieces.len().div_ceil(MAX_STEPS);
+                    let len = self.pieces.len();
+                    sizes = (0..len.div_ceil(n)).map(|i| n.min(len - i * n)).collect();
+                }
+                sizes
+            }
+        };
+        let mut i = 0;
+        for (step, &size) in sizes.iter().enumerate() {
+            for p in &mut self.pieces[i..i + size] {
+                p.step = Step(step as u32 + 1);
+            }
+            i += size;
         }
     }
 
@@ -148,6 +180,10 @@ impl Assembly {
     }
 }
 
+/// New pieces a step holds at most by default, so a person sees at once
+/// what to add (a course with more is split into several steps).
+pub const STEP_PIECES: usize = 8;
+
 /// Steps LeoCAD shows at most (its step counter is one byte); a model with
 /// more steps loads, but its later steps are missing from the view.
 pub const MAX_STEPS: usize = 255;
@@ -155,10 +191,11 @@ pub const MAX_STEPS: usize = 255;
 /// How pieces are grouped into steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum StepGrouping {
-    /// One piece a step, or as few pieces a step as keep the steps within
-    /// [`MAX_STEPS`] (the default).
+    /// A step per run of pieces on one course, split into balanced steps
+    /// of at most [`STEP_PIECES`] pieces, more a step when that keeps the
+    /// build within [`MAX_STEPS`] (the default).
     Auto,
-    /// One piece a step (the default).
+    /// One piece a step.
     Each,
     /// At most this many pieces a step.
     Size(usize),
@@ -180,9 +217,11 @@ mod tests {
 
     #[test]
     fn auto_steps_stay_within_what_leocad_shows() {
+        // Three pieces a course: a step a course.
         let mut small = assembly(200);
         small.regroup(StepGrouping::Auto);
-        assert_eq!(small.step_count(), 200);
+        assert_eq!(small.step_count(), 67);
+        // 1000 courses would be 334 steps: runs are merged to stay in 255.
         let mut big = assembly(1000);
         big.regroup(StepGrouping::Auto);
         assert_eq!(big.step_count(), 250);
@@ -193,6 +232,31 @@ mod tests {
         let mut layers = assembly(9);
         layers.regroup(StepGrouping::Layer);
         assert_eq!(layers.step_count(), 3);
+        let mut each = assembly(9);
+        each.regroup(StepGrouping::Each);
+        assert_eq!(each.step_count(), 9);
+    }
+
+    #[test]
+    fn a_big_course_is_split_into_balanced_steps() {
+        let part = PartKind::from_id("3005").unwrap();
+        let order: Vec<Placement> = (0..20)
+            .map(|i| Placement::new(part, Cell::new(i, 0, 0), Rot::R0))
+            .chain((0..3).map(|i| Placement::new(part, Cell::new(i, 0, 1), Rot::R0)))
+            .collect();
+        let mut a = Assembly::from_order(&order, 24, Color::RED);
+        a.regroup(StepGrouping::Auto);
+        let mut sizes = vec![0; a.step_count() as usize];
+        for p in &a.pieces {
+            sizes[p.step.0 as usize - 1] += 1;
+        }
+        assert_eq!(sizes, [7, 7, 6, 3]);
+        // Steps never mix courses.
+        for w in a.pieces.windows(2) {
+            if w[0].placement.origin.z != w[1].placement.origin.z {
+                assert_ne!(w[0].step, w[1].step);
+            }
+        }
     }
 
     #[test]

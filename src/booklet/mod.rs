@@ -1,0 +1,715 @@
+//! The instruction booklet: a printable PDF made from one assembly and its
+//! rendered images.
+//!
+//! The booklet has, in order:
+//! - a cover: the title, the finished model, the piece count and the size
+//!   in studs and centimetres;
+//! - the bill of materials: each part and colour with its picture, count,
+//!   name, colour name, and LDraw and BrickLink ids;
+//! - the step pages: a big step number, a parts-needed callout (pictures
+//!   with "2x" counts) and the step image. Several small steps share a
+//!   page; a step is never split;
+//! - a last page with the exploded view.
+//!
+//! Every page but the cover is numbered. Text is PDF text in a standard
+//! font (selectable, searchable, no font embedded), not pixels. The layout
+//! comes from a [`Template`]. Pages are planned first ([`plan_steps`], a
+//! pure function that tests check), then drawn with printpdf's operation
+//! lists.
+//!
+//! The images come from the caller (the pipeline renders them with
+//! brickwright's renderer); this module only lays them out.
+
+pub mod template;
+
+use std::collections::BTreeMap;
+use std::io::{self, Write};
+
+use image::RgbaImage;
+use printpdf::{
+    BuiltinFont, Color as PdfColor, Line, LinePoint, Mm, Op, PaintMode, ParsedFont, PdfDocument,
+    PdfFontHandle, PdfPage, PdfSaveOptions, Point, Pt, RawImage, RawImageData, RawImageFormat,
+    Rect, Rgb as PdfRgb, TextItem, XObject, XObjectId, XObjectTransform,
+};
+
+use crate::assembly::Assembly;
+use crate::catalog::{Color, PartKind};
+pub use template::Template;
+use template::{FontFamily, Rgb};
+
+/// Everything a booklet shows.
+pub struct BookletInput<'a> {
+    /// The title on the cover and in the PDF's metadata.
+    pub title: &'a str,
+    /// The build, with its steps grouped as the booklet shows them.
+    pub assembly: &'a Assembly,
+    /// Size in studs (x, y) and height in bricks.
+    pub size_studs: [f64; 3],
+    /// Size in centimetres (x, y, height).
+    pub size_cm: [f64; 3],
+    /// The finished model.
+    pub model: &'a RgbaImage,
+    /// The exploded view.
+    pub exploded: &'a RgbaImage,
+    /// One image per step, step 1 first.
+    pub steps: &'a [RgbaImage],
+    /// A picture of each part in each colour the build uses.
+    pub parts: &'a BTreeMap<(PartKind, Color), RgbaImage>,
+}
+
+/// How much of a page a step takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Share {
+    /// A quarter page (four steps a page).
+    Quarter,
+    /// Half a page.
+    Half,
+    /// A whole page.
+    Full,
+}
+
+impl Share {
+    /// Steps a page of this share holds.
+    pub fn per_page(self) -> usize {
+        match self {
+            Share::Quarter => 4,
+            Share::Half => 2,
+            Share::Full => 1,
+        }
+    }
+}
+
+/// One step page: its share and the steps on it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepPage {
+    /// The share every step on the page takes.
+    pub share: Share,
+    /// Step numbers on the page, in order.
+    pub steps: Vec<u32>,
+}
+
+/// The new parts of each step, as callout lines: part, colour, count.
+pub fn step_parts(assembly: &Assembly) -> Vec<Vec<(PartKind, Color, usize)>> {
+    let mut steps: Vec<BTreeMap<(PartKind, Color), usize>> =
+        vec![BTreeMap::new(); assembly.step_count() as usize];
+    for p in &assembly.pieces {
+        *steps[p.step.0 as usize - 1]
+            .entry((p.placement.part, p.color))
+            .or_insert(0) += 1;
+    }
+    steps
+        .into_iter()
+        .map(|m| m.into_iter().map(|((p, c), n)| (p, c, n)).collect())
+        .collect()
+}
+
+/// Callout items a step's share holds (pictures in at most two rows).
+fn callout_capacity(share: Share, content_w: f32) -> usize {
+    let cell_w = match share {
+        Share::Quarter => content_w / 2.0,
+        Share::Half | Share::Full => content_w,
+    };
+    let per_row = ((cell_w - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W)
+        .floor()
+        .max(1.0) as usize;
+    per_row * if share == Share::Full { 3 } else { 2 }
+}
+
+/// Plans the step pages: each step takes the smallest share its callout
+/// fits (never more steps a page than the template allows), and a page
+/// holds consecutive steps of one share. A step is never split.
+pub fn plan_steps(callout_lines: &[usize], template: &Template) -> Vec<StepPage> {
+    let content_w = template.page.size.mm().0 - 2.0 * template.page.margin;
+    let max_per_page = template.steps.per_page as usize;
+    let need = |lines: usize| {
+        [Share::Quarter, Share::Half, Share::Full]
+            .into_iter()
+            .filter(|s| s.per_page() <= max_per_page)
+            .find(|&s| lines <= callout_capacity(s, content_w))
+            .unwrap_or(Share::Full)
+    };
+    let mut pages: Vec<StepPage> = Vec::new();
+    for (i, &lines) in callout_lines.iter().enumerate() {
+        let share = need(lines);
+        let step = i as u32 + 1;
+        match pages.last_mut() {
+            Some(page) if page.share == share && page.steps.len() < share.per_page() => {
+                page.steps.push(step);
+            }
+            _ => pages.push(StepPage {
+                share,
+                steps: vec![step],
+            }),
+        }
+    }
+    pages
+}
+
+/// Width of a callout item (picture and count), millimetres.
+const CALLOUT_ITEM_W: f32 = 20.0;
+/// Padding inside the callout box, millimetres.
+const CALLOUT_PAD: f32 = 2.5;
+/// Side of a callout picture, millimetres.
+const CALLOUT_PICTURE: f32 = 15.0;
+
+/// Page furniture: fonts and their metrics.
+struct Fonts {
+    regular: BuiltinFont,
+    bold: BuiltinFont,
+    metrics_regular: Option<ParsedFont>,
+    metrics_bold: Option<ParsedFont>,
+}
+
+impl Fonts {
+    fn new(family: FontFamily) -> Self {
+        let (regular, bold) = match family {
+            FontFamily::Helvetica => (BuiltinFont::Helvetica, BuiltinFont::HelveticaBold),
+            FontFamily::Times => (BuiltinFont::TimesRoman, BuiltinFont::TimesBold),
+            FontFamily::Courier => (BuiltinFont::Courier, BuiltinFont::CourierBold),
+        };
+        let metrics = |f: BuiltinFont| {
+            let bytes = f.get_subset_font().bytes;
+            ParsedFont::from_bytes(&bytes, 0, &mut Vec::new())
+        };
+        Fonts {
+            regular,
+            bold,
+            metrics_regular: metrics(regular),
+            metrics_bold: metrics(bold),
+        }
+    }
+
+    /// Width of `text` at `size` points, millimetres.
+    fn width(&self, text: &str, size: f32, bold: bool) -> f32 {
+        let font = if bold {
+            &self.metrics_bold
+        } else {
+            &self.metrics_regular
+        };
+        let em = match font {
+            Some(f) => {
+                let units = f32::from(f.units_per_em.max(1));
+                text.chars()
+                    .map(|c| {
+                        f.lookup_glyph_index(c as u32)
+                            .and_then(|g| f.get_glyph_width(g))
+                            .map_or(0.55, |w| f32::from(w) / units)
+                    })
+                    .sum::<f32>()
+            }
+            // No metrics: the average width of a Helvetica character.
+            None => text.chars().count() as f32 * 0.55,
+        };
+        em * size * 25.4 / 72.0
+    }
+}
+
+/// One page's operations, laid out in millimetres from the top-left
+/// corner and written in PDF points from the bottom-left.
+struct PageOps {
+    ops: Vec<Op>,
+    height: f32,
+}
+
+fn pdf_rgb(c: Rgb) -> PdfColor {
+    PdfColor::Rgb(PdfRgb {
+        r: f32::from(c.0[0]) / 255.0,
+        g: f32::from(c.0[1]) / 255.0,
+        b: f32::from(c.0[2]) / 255.0,
+        icc_profile: None,
+    })
+}
+
+impl PageOps {
+    fn new(height: f32) -> Self {
+        PageOps {
+            ops: Vec::new(),
+            height,
+        }
+    }
+
+    fn point(&self, x: f32, y: f32) -> Point {
+        Point::new(Mm(x), Mm(self.height - y))
+    }
+
+    /// Text with its baseline at `y`.
+    fn text(&mut self, fonts: &Fonts, x: f32, y: f32, style: (f32, bool, Rgb), s: &str) {
+        let (size, bold, color) = style;
+        let font = if bold { fonts.bold } else { fonts.regular };
+        let pos = self.point(x, y);
+        self.ops.extend([
+            Op::StartTextSection,
+            Op::SetFillColor {
+                col: pdf_rgb(color),
+            },
+            Op::SetFont {
+                font: PdfFontHandle::Builtin(font),
+                size: Pt(size),
+            },
+            Op::SetTextCursor { pos },
+            Op::ShowText {
+                items: vec![TextItem::Text(s.to_string())],
+            },
+            Op::EndTextSection,
+        ]);
+    }
+
+    /// A filled rectangle, top-left at (x, y).
+    fn fill(&mut self, x: f32, y: f32, w: f32, h: f32, color: Rgb) {
+        let ll = self.point(x, y + h);
+        self.ops.extend([
+            Op::SetFillColor {
+                col: pdf_rgb(color),
+            },
+            Op::DrawRectangle {
+                rectangle: Rect {
+                    mode: Some(PaintMode::Fill),
+                    ..Rect::from_xywh(ll.x, ll.y, Mm(w).into(), Mm(h).into())
+                },
+            },
+        ]);
+    }
+
+    /// A thin horizontal line.
+    fn rule(&mut self, x0: f32, x1: f32, y: f32, color: Rgb) {
+        let (a, b) = (self.point(x0, y), self.point(x1, y));
+        self.ops.extend([
+            Op::SetOutlineColor {
+                col: pdf_rgb(color),
+            },
+            Op::SetOutlineThickness { pt: Pt(0.5) },
+            Op::DrawLine {
+                line: Line {
+                    points: vec![
+                        LinePoint {
+                            p: a,
+                            bezier: false,
+                        },
+                        LinePoint {
+                            p: b,
+                            bezier: false,
+                        },
+                    ],
+                    is_closed: false,
+                },
+            },
+        ]);
+    }
+
+    /// An image fitted into the box (x, y, w, h), centred, aspect kept.
+    fn image(&mut self, img: &Placed, x: f32, y: f32, w: f32, h: f32) {
+        self.image_at(img, x, y, w, h, false);
+    }
+
+    /// An image fitted into the box, centred across, at the top of the box
+    /// when `top` (else centred down too).
+    fn image_at(&mut self, img: &Placed, x: f32, y: f32, w: f32, h: f32, top: bool) {
+        if img.width == 0 || img.height == 0 || w <= 0.0 || h <= 0.0 {
+            return;
+        }
+        let scale = (w / img.width as f32).min(h / img.height as f32);
+        let (iw, ih) = (img.width as f32 * scale, img.height as f32 * scale);
+        let ix = x + (w - iw) / 2.0;
+        let iy = if top { y } else { y + (h - ih) / 2.0 };
+        let ll = self.point(ix, iy + ih);
+        // At 72 dpi one pixel is one point; scale from there.
+        let pt_per_mm = 72.0 / 25.4;
+        self.ops.push(Op::UseXobject {
+            id: img.id.clone(),
+            transform: XObjectTransform {
+                translate_x: Some(ll.x),
+                translate_y: Some(ll.y),
+                scale_x: Some(iw * pt_per_mm / img.width as f32),
+                scale_y: Some(ih * pt_per_mm / img.height as f32),
+                dpi: Some(72.0),
+                ..Default::default()
+            },
+        });
+    }
+}
+
+/// An image added to the document, by id and pixel size.
+#[derive(Clone)]
+struct Placed {
+    id: XObjectId,
+    width: usize,
+    height: usize,
+}
+
+/// Adds `img` to the document's resources under a name made from `n`
+/// (stable names keep the output the same run to run).
+fn add_image(doc: &mut PdfDocument, n: &mut usize, img: &RgbaImage) -> Placed {
+    // Flatten onto white: printed pages have no alpha.
+    let mut rgb = Vec::with_capacity(img.width() as usize * img.height() as usize * 3);
+    for p in img.pixels() {
+        let a = u32::from(p.0[3]);
+        for c in &p.0[..3] {
+            rgb.push(((u32::from(*c) * a + 255 * (255 - a) + 127) / 255) as u8);
+        }
+    }
+    let id = XObjectId(format!("Im{n}"));
+    *n += 1;
+    let raw = RawImage {
+        pixels: RawImageData::U8(rgb),
+        width: img.width() as usize,
+        height: img.height() as usize,
+        data_format: RawImageFormat::RGB8,
+        tag: Vec::new(),
+    };
+    doc.resources
+        .xobjects
+        .map
+        .insert(id.clone(), XObject::Image(raw));
+    Placed {
+        id,
+        width: img.width() as usize,
+        height: img.height() as usize,
+    }
+}
+
+/// Writes the booklet as PDF.
+pub fn write_booklet<W: Write + ?Sized>(
+    w: &mut W,
+    input: &BookletInput<'_>,
+    template: &Template,
+) -> io::Result<()> {
+    let pdf = booklet_bytes(input, template)?;
+    w.write_all(&pdf)
+}
+
+/// The pages the booklet will have: cover, parts list pages, step pages,
+/// exploded view.
+pub fn page_count(input: &BookletInput<'_>, template: &Template) -> usize {
+    let lines: Vec<usize> = step_parts(input.assembly).iter().map(Vec::len).collect();
+    1 + bom_pages(bom_lines(input.assembly).len(), template)
+        + plan_steps(&lines, template).len()
+        + 1
+}
+
+fn bom_lines(assembly: &Assembly) -> Vec<(PartKind, Color, usize)> {
+    let mut counts: BTreeMap<(PartKind, Color), usize> = BTreeMap::new();
+    for p in &assembly.pieces {
+        *counts.entry((p.placement.part, p.color)).or_insert(0) += 1;
+    }
+    counts.into_iter().map(|((p, c), n)| (p, c, n)).collect()
+}
+
+/// Parts-list geometry: columns and rows of cells on a page.
+const BOM_COLUMNS: usize = 4;
+const BOM_CELL_H: f32 = 46.0;
+
+fn bom_rows_per_page(template: &Template) -> usize {
+    let (_, h) = template.page.size.mm();
+    let usable = h - 2.0 * template.page.margin - 16.0 - 8.0;
+    ((usable / BOM_CELL_H).floor() as usize).max(1)
+}
+
+fn bom_pages(lines: usize, template: &Template) -> usize {
+    lines
+        .div_ceil(BOM_COLUMNS * bom_rows_per_page(template))
+        .max(1)
+}
+
+fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> {
+    let steps = step_parts(input.assembly);
+    if input.steps.len() != steps.len() {
+        return Err(io::Error::other(format!(
+            "the booklet has {} step images for {} steps",
+            input.steps.len(),
+            steps.len()
+        )));
+    }
+    let fonts = Fonts::new(t.fonts.family);
+    let (pw, ph) = t.page.size.mm();
+    let m = t.page.margin;
+    let (cw, ch) = (pw - 2.0 * m, ph - 2.0 * m);
+    let text = t.colors.text;
+    let ts = t.fonts.text_size;
+    let mut doc = PdfDocument::new(input.title);
+    doc.metadata.info.creator = format!("brickwright {}", env!("CARGO_PKG_VERSION"));
+    doc.metadata.info.producer = doc.metadata.info.creator.clone();
+    let mut n = 0usize;
+    let mut pages: Vec<PdfPage> = Vec::new();
+    let mut number = 1usize;
+    let mut finish = |mut page: PageOps, pages: &mut Vec<PdfPage>, numbered: bool| {
+        if numbered {
+            let label = number.to_string();
+            let x = pw / 2.0 - fonts.width(&label, ts, false) / 2.0;
+            page.text(&fonts, x, ph - m / 2.0, (ts, false, text), &label);
+        }
+        number += 1;
+        pages.push(PdfPage::new(Mm(pw), Mm(ph), page.ops));
+    };
+
+    // Cover.
+    let mut page = PageOps::new(ph);
+    let title_size = t.fonts.title_size;
+    let title_w = fonts.width(input.title, title_size, true);
+    page.text(
+        &fonts,
+        (pw - title_w).max(0.0) / 2.0,
+        m + title_size * 0.3528,
+        (title_size, true, t.colors.accent),
+        input.title,
+    );
+    let model = add_image(&mut doc, &mut n, input.model);
+    let top = m + title_size * 0.3528 + 8.0;
+    page.image(&model, m, top, cw, ch - (top - m) - 30.0);
+    let pieces = input.assembly.pieces.len();
+    let [sx, sy, sh] = input.size_studs;
+    let [cx, cy, chh] = input.size_cm;
+    let lines = [
+        format!("{pieces} pieces"),
+        format!("{sx} x {sy} studs, {sh} bricks high"),
+        format!("{cx:.1} x {cy:.1} x {chh:.1} cm"),
+    ];
+    let mut y = ph - m - 22.0;
+    for (i, l) in lines.iter().enumerate() {
+        let size = if i == 0 {
+            t.fonts.heading_size
+        } else {
+            ts * 1.4
+        };
+        let wd = fonts.width(l, size, i == 0);
+        page.text(&fonts, (pw - wd) / 2.0, y, (size, i == 0, text), l);
+        y += size * 0.3528 + 3.0;
+    }
+    finish(page, &mut pages, false);
+
+    // Parts pictures, each added once.
+    let mut pictures: BTreeMap<(PartKind, Color), Placed> = BTreeMap::new();
+    for (key, img) in input.parts {
+        pictures.insert(*key, add_image(&mut doc, &mut n, img));
+    }
+
+    // Bill of materials.
+    let bom = bom_lines(input.assembly);
+    let rows = bom_rows_per_page(t);
+    let cell_w = cw / BOM_COLUMNS as f32;
+    for chunk in bom.chunks(BOM_COLUMNS * rows) {
+        let mut page = PageOps::new(ph);
+        let hs = t.fonts.heading_size;
+        let head_y = m + hs * 0.3528;
+        page.text(&fonts, m, head_y, (hs, true, t.colors.accent), "Parts list");
+        let total = format!("{pieces} pieces, {} kinds", bom.len());
+        let tw = fonts.width(&total, ts, false);
+        page.text(&fonts, pw - m - tw, head_y, (ts, false, text), &total);
+        page.rule(m, pw - m, head_y + 3.0, t.colors.rule);
+        for (i, &(part, color, count)) in chunk.iter().enumerate() {
+            let (col, row) = (i % BOM_COLUMNS, i / BOM_COLUMNS);
+            let x = m + col as f32 * cell_w;
+            let y = head_y + 8.0 + row as f32 * BOM_CELL_H;
+            if let Some(pic) = pictures.get(&(part, color)) {
+                page.image(pic, x + 2.0, y, cell_w - 4.0, 22.0);
+            }
+            let spec = part.spec();
+            let bl_color = color
+                .spec()
+                .map_or_else(|| "no BrickLink colour".into(), |c| c.bricklink.to_string());
+            let mut ly = y + 22.0 + ts * 0.3528 + 2.0;
+            page.text(
+                &fonts,
+                x + 2.0,
+                ly,
+                (ts * 1.3, true, text),
+                &format!("{count}x"),
+            );
+            ly += ts * 0.3528 * 1.3 + 1.5;
+            for (l, s) in [
+                spec.name.to_string(),
+                color.name(),
+                format!("LDraw {} / {}", spec.id, color.0),
+                format!("BrickLink {} / {}", spec.bricklink, bl_color),
+            ]
+            .iter()
+            .enumerate()
+            {
+                let size = if l == 0 { ts } else { ts * 0.85 };
+                page.text(&fonts, x + 2.0, ly, (size, false, text), s);
+                ly += size * 0.3528 + 1.2;
+            }
+        }
+        finish(page, &mut pages, true);
+    }
+
+    // Steps.
+    let lines: Vec<usize> = steps.iter().map(Vec::len).collect();
+    for plan in plan_steps(&lines, t) {
+        let mut page = PageOps::new(ph);
+        let (cols, rows) = match plan.share {
+            Share::Quarter => (2, 2),
+            Share::Half => (1, 2),
+            Share::Full => (1, 1),
+        };
+        let (sw, sh) = (cw / cols as f32, (ch - 4.0) / rows as f32);
+        for (i, &step) in plan.steps.iter().enumerate() {
+            let (x, y) = (m + (i % cols) as f32 * sw, m + (i / cols) as f32 * sh);
+            if i > 0 && i % cols == 0 {
+                page.rule(m, pw - m, y - 1.0, t.colors.rule);
+            }
+            let ns = t.fonts.step_number_size;
+            let label = step.to_string();
+            page.text(
+                &fonts,
+                x + 1.0,
+                y + ns * 0.3528,
+                (ns, true, t.colors.accent),
+                &label,
+            );
+            // Parts-needed callout to the right of the number.
+            let items = &steps[step as usize - 1];
+            let cx = x + fonts.width(&label, ns, true) + 5.0;
+            let avail = (x + sw - 2.0 - cx).max(CALLOUT_ITEM_W + 2.0 * CALLOUT_PAD);
+            let per_row = ((avail - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W)
+                .floor()
+                .max(1.0) as usize;
+            let used_cols = per_row.min(items.len()).max(1);
+            let item_rows = items.len().div_ceil(per_row).max(1);
+            let item_h = CALLOUT_PICTURE + ts * 0.3528 + 3.0;
+            let box_w = used_cols as f32 * CALLOUT_ITEM_W + 2.0 * CALLOUT_PAD;
+            let box_h = item_rows as f32 * item_h + 2.0 * CALLOUT_PAD;
+            page.fill(cx, y, box_w, box_h, t.colors.callout);
+            for (j, &(part, color, count)) in items.iter().enumerate() {
+                let ix = cx + CALLOUT_PAD + (j % per_row) as f32 * CALLOUT_ITEM_W;
+                let iy = y + CALLOUT_PAD + (j / per_row) as f32 * item_h;
+                if let Some(pic) = pictures.get(&(part, color)) {
+                    page.image(pic, ix, iy, CALLOUT_ITEM_W - 2.0, CALLOUT_PICTURE);
+                }
+                let label = format!("{count}x");
+                page.text(
+                    &fonts,
+                    ix + 1.0,
+                    iy + CALLOUT_PICTURE + ts * 0.3528 + 1.0,
+                    (ts, true, text),
+                    &label,
+                );
+            }
+            let top = y + box_h.max(ns * 0.3528) + 3.0;
+            let img = add_image(&mut doc, &mut n, &input.steps[step as usize - 1]);
+            page.image_at(&img, x + 1.0, top, sw - 2.0, y + sh - top - 2.0, true);
+        }
+        finish(page, &mut pages, true);
+    }
+
+    // Exploded view.
+    let mut page = PageOps::new(ph);
+    let hs = t.fonts.heading_size;
+    page.text(
+        &fonts,
+        m,
+        m + hs * 0.3528,
+        (hs, true, t.colors.accent),
+        "Exploded view",
+    );
+    let ex = add_image(&mut doc, &mut n, input.exploded);
+    let top = m + hs * 0.3528 + 6.0;
+    page.image(&ex, m, top, cw, ch - (top - m) - 4.0);
+    finish(page, &mut pages, true);
+
+    let mut warnings = Vec::new();
+    Ok(doc
+        .with_pages(pages)
+        .save(&PdfSaveOptions::default(), &mut warnings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{Placement, StepGrouping};
+    use crate::geom::{Cell, Rot};
+
+    /// A two-course wall of 2x4s and a slope, one colour per course, and
+    /// flat test pictures for it.
+    fn wall() -> Assembly {
+        let brick = PartKind::from_id("3001").unwrap();
+        let slope = PartKind::from_id("3039").unwrap();
+        let mut order = Vec::new();
+        for i in 0..6 {
+            order.push(Placement::new(brick, Cell::new(4 * i, 0, 0), Rot::R0));
+        }
+        for i in 0..5 {
+            order.push(Placement::new(brick, Cell::new(4 * i + 2, 0, 1), Rot::R0));
+        }
+        order.push(Placement::new(slope, Cell::new(2, 0, 4), Rot::R0));
+        let mut a = Assembly::from_order(&order, 12, Color::RED);
+        a.paint(crate::catalog::Palette::Layers, 1);
+        a.regroup(StepGrouping::Size(2));
+        a
+    }
+
+    fn picture(w: u32, h: u32, rgb: [u8; 3]) -> RgbaImage {
+        RgbaImage::from_fn(w, h, |x, y| {
+            let edge = x < 2 || y < 2 || x + 2 >= w || y + 2 >= h;
+            let c = if edge { [0, 0, 0] } else { rgb };
+            image::Rgba([c[0], c[1], c[2], 255])
+        })
+    }
+
+    pub(crate) fn sample_pdf(template: &Template) -> (Vec<u8>, usize) {
+        let a = wall();
+        let steps: Vec<RgbaImage> = (0..a.step_count())
+            .map(|i| picture(160, 120, [200, 200 - 20 * i as u8, 120]))
+            .collect();
+        let mut parts = BTreeMap::new();
+        for p in &a.pieces {
+            parts
+                .entry((p.placement.part, p.color))
+                .or_insert_with(|| picture(64, 64, p.color.rgb()));
+        }
+        let (model, exploded) = (
+            picture(200, 150, [90, 90, 200]),
+            picture(150, 200, [90, 200, 90]),
+        );
+        let input = BookletInput {
+            title: "wall",
+            assembly: &a,
+            size_studs: [24.0, 2.0, 2.5],
+            size_cm: [19.2, 1.6, 2.4],
+            model: &model,
+            exploded: &exploded,
+            steps: &steps,
+            parts: &parts,
+        };
+        let mut pdf = Vec::new();
+        write_booklet(&mut pdf, &input, template).unwrap();
+        (pdf, page_count(&input, template))
+    }
+
+    #[test]
+    fn the_booklet_is_a_pdf_with_the_planned_pages() {
+        let (pdf, pages) = sample_pdf(&Template::default());
+        assert!(pdf.starts_with(b"%PDF-"));
+        // Cover, one parts-list page, 6 steps on two quarter pages, exploded view.
+        assert_eq!(pages, 1 + 1 + 2 + 1);
+        std::fs::write("/tmp/sample-booklet.pdf", &pdf).unwrap();
+        let again = sample_pdf(&Template::default()).0;
+        assert_eq!(pdf.len(), again.len());
+        let mut letter = Template::default();
+        letter.page.size = template::PageSize::Letter;
+        letter.steps.per_page = 1;
+        assert_eq!(sample_pdf(&letter).1, 1 + 1 + 6 + 1);
+    }
+
+    #[test]
+    fn small_steps_share_pages_and_big_ones_get_room() {
+        let t = Template::default();
+        // Quarter cells hold 2 rows of 4 items on A4 with 12 mm margins.
+        let plan = plan_steps(&[1, 2, 1, 3, 1, 12, 1, 1, 30], &t);
+        let shares: Vec<(Share, Vec<u32>)> = plan.into_iter().map(|p| (p.share, p.steps)).collect();
+        assert_eq!(
+            shares,
+            [
+                (Share::Quarter, vec![1, 2, 3, 4]),
+                (Share::Quarter, vec![5]),
+                (Share::Half, vec![6]),
+                (Share::Quarter, vec![7, 8]),
+                (Share::Full, vec![9]),
+            ]
+        );
+        let mut one = t.clone();
+        one.steps.per_page = 1;
+        assert!(plan_steps(&[1, 1, 1], &one)
+            .iter()
+            .all(|p| p.share == Share::Full && p.steps.len() == 1));
+    }
+}
