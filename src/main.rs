@@ -179,8 +179,8 @@ struct BuildArgs {
     /// The condition the BrickLink wanted list asks for: N (new) or U (used); default any.
     #[arg(long, value_enum)]
     condition: Option<ConditionArg>,
-    /// The files to write, comma-separated: ldr, bricklink, csv, or all (report.json is
-    /// always written).
+    /// The files to write, comma-separated: ldr, glb, exploded-glb, gltf, bricklink, csv, or
+    /// all (every one but gltf); report.json is always written.
     #[arg(long, default_value = "all", value_parser = parse_formats)]
     formats: pipeline::Formats,
     /// Give up the search after this many seconds.

@@ -14,6 +14,7 @@ use thiserror::Error;
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, StepGrouping};
 use crate::catalog::{Color, Family, Palette};
+use crate::export::gltf::{write_gltf, Container, GltfOptions};
 use crate::export::partslist::{
     write_bricklink, write_rebrickable_csv, Condition, PartsList, PartsRow,
 };
@@ -64,6 +65,13 @@ pub struct BuildOptions {
 pub enum Format {
     /// `<stem>.ldr`: the LDraw model, a `0 STEP` per step.
     Ldr,
+    /// `<stem>.glb`: the glTF 2.0 assembly with its build animation.
+    Glb,
+    /// `<stem>-exploded.glb`: the glTF assembly pulled apart.
+    ExplodedGlb,
+    /// `<stem>.gltf`: the glTF assembly as JSON with its data embedded
+    /// (not in the default set: name it).
+    Gltf,
     /// `<stem>-bricklink.xml`: a BrickLink wanted list.
     Bricklink,
     /// `<stem>-parts.csv`: a Rebrickable parts list.
@@ -72,12 +80,28 @@ pub enum Format {
 
 impl Format {
     /// Every format, in the order files are written.
-    pub const ALL: [Format; 3] = [Format::Ldr, Format::Bricklink, Format::Csv];
+    pub const ALL: [Format; 6] = [
+        Format::Ldr,
+        Format::Glb,
+        Format::ExplodedGlb,
+        Format::Gltf,
+        Format::Bricklink,
+        Format::Csv,
+    ];
+
+    /// Whether `--formats all` (and the default) includes it: every format
+    /// but `.gltf`, which repeats the `.glb` as JSON.
+    pub fn in_all(self) -> bool {
+        self != Format::Gltf
+    }
 
     /// The name `--formats` takes.
     pub fn name(self) -> &'static str {
         match self {
             Format::Ldr => "ldr",
+            Format::Glb => "glb",
+            Format::ExplodedGlb => "exploded-glb",
+            Format::Gltf => "gltf",
             Format::Bricklink => "bricklink",
             Format::Csv => "csv",
         }
@@ -87,6 +111,9 @@ impl Format {
     pub fn file_name(self, stem: &str) -> String {
         match self {
             Format::Ldr => format!("{stem}.ldr"),
+            Format::Glb => format!("{stem}.glb"),
+            Format::ExplodedGlb => format!("{stem}-exploded.glb"),
+            Format::Gltf => format!("{stem}.gltf"),
             Format::Bricklink => format!("{stem}-bricklink.xml"),
             Format::Csv => format!("{stem}-parts.csv"),
         }
@@ -98,9 +125,9 @@ impl Format {
 pub struct Formats(Vec<Format>);
 
 impl Default for Formats {
-    /// Every format.
+    /// Every format but `.gltf`.
     fn default() -> Self {
-        Formats(Format::ALL.to_vec())
+        Formats(Format::ALL.into_iter().filter(|f| f.in_all()).collect())
     }
 }
 
@@ -111,7 +138,7 @@ impl Formats {
         let mut set = Vec::new();
         for name in s.split(',').map(str::trim).filter(|n| !n.is_empty()) {
             if name == "all" {
-                set.extend(Format::ALL);
+                set.extend(Format::ALL.into_iter().filter(|f| f.in_all()));
                 continue;
             }
             let f = Format::ALL
@@ -124,7 +151,11 @@ impl Formats {
             set.push(f);
         }
         if set.is_empty() {
-            return Err("no format given (known: ldr, bricklink, csv, all)".into());
+            let known: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+            return Err(format!(
+                "no format given (known: {}, all)",
+                known.join(", ")
+            ));
         }
         set.sort_unstable();
         set.dedup();
@@ -498,6 +529,17 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         let path = opts.out_dir.join(format.file_name(&stem));
         let written = match format {
             Format::Ldr => files.add(&path, |w| write_ldr(w, &assembly, &meta)),
+            Format::Glb | Format::ExplodedGlb | Format::Gltf => {
+                let gltf = GltfOptions::default()
+                    .with_name(&stem)
+                    .with_exploded(format == Format::ExplodedGlb)
+                    .with_container(if format == Format::Gltf {
+                        Container::Embedded
+                    } else {
+                        Container::Binary
+                    });
+                files.add(&path, |w| write_gltf(w, &assembly, &gltf))
+            }
             Format::Bricklink => files.add(&path, |w| write_bricklink(w, &parts, opts.condition)),
             Format::Csv => files.add(&path, |w| write_rebrickable_csv(w, &parts)),
         };

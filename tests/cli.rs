@@ -145,14 +145,20 @@ fn build_and_verify(name: &str) {
     let ldr = out.join(format!("{stem}.ldr"));
     assert!(ldr.is_file(), "{} was not written", ldr.display());
     let report = read_report(&out);
-    let mut expected: Vec<PathBuf> = ["ldr", "-bricklink.xml", "-parts.csv"]
-        .iter()
-        .map(|suffix| match *suffix {
-            "ldr" => ldr.clone(),
-            _ => out.join(format!("{stem}{suffix}")),
-        })
-        .chain([out.join("report.json")])
-        .collect();
+    let mut expected: Vec<PathBuf> = [
+        "ldr",
+        ".glb",
+        "-exploded.glb",
+        "-bricklink.xml",
+        "-parts.csv",
+    ]
+    .iter()
+    .map(|suffix| match *suffix {
+        "ldr" => ldr.clone(),
+        _ => out.join(format!("{stem}{suffix}")),
+    })
+    .chain([out.join("report.json")])
+    .collect();
     expected.sort();
     assert_eq!(
         files_under(tmp.path()),
