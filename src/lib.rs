@@ -18,6 +18,7 @@
 //! - [`assembly`] is the ordered build every exporter reads, with an
 //!   independent verifier.
 //! - [`ldraw`] writes (and reads back) LDraw `.ldr` files.
+//! - [`render`] draws instruction images: step pictures and part pictures.
 //! - [`pipeline`] ties the stages together for the command-line tool.
 
 pub mod assembly;
@@ -28,5 +29,6 @@ pub mod grammar;
 pub mod ldraw;
 pub mod mesh;
 pub mod pipeline;
+pub mod render;
 pub mod search;
 pub mod voxel;

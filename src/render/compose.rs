@@ -1,0 +1,249 @@
+//! From samples to pixels: colours, fading, outlines and the box filter.
+//!
+//! The rasterizer leaves, per sample, a depth, a piece and a face. Here
+//! each sample gets its colour (the piece's colour times the face's shade,
+//! blended toward white for pieces of earlier steps), and samples on an
+//! edge get the line colour instead. A sample is on an edge when one of
+//! its four neighbours belongs to another piece or to the background, faces
+//! a direction more than about 37 degrees away, or lies far behind or in
+//! front of it (a stud seen against the top behind it). Lines are then
+//! thickened by a small square dilation, thicker for the pieces the step
+//! adds, and every `ss x ss` block of samples is averaged into one pixel:
+//! that average is the anti-aliasing.
+//!
+//! Everything a pixel needs lies within a few samples of it, so a
+//! rectangle of the image can be composed again on its own: the step
+//! renderer redraws only where the step changed something.
+
+use image::{Rgb, RgbaImage};
+
+use super::raster::{PixelRect, Samples, EMPTY};
+
+/// Classes of pieces, which decide fading and line weight; higher wins
+/// where two pieces meet.
+pub(crate) mod class {
+    /// A piece of an earlier step: faded, light lines.
+    pub const OLD: u8 = 1;
+    /// A piece shown plainly (the finished model, a single part).
+    pub const PLAIN: u8 = 2;
+    /// A piece the step adds: full colour, strong lines.
+    pub const NEW: u8 = 3;
+}
+
+/// How one piece looks in the image being composed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct PieceLook {
+    /// Base colour.
+    pub rgb: [u8; 3],
+    /// One of [`class`].
+    pub class: u8,
+}
+
+/// Everything about the look that is the same for every piece.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Style {
+    /// Blend of old pieces toward white, in 256ths.
+    pub fade: u16,
+    /// Dilation of ordinary lines, in samples.
+    pub radius: usize,
+    /// Dilation of the lines of new pieces, in samples (at least `radius`).
+    pub radius_new: usize,
+    /// Depth jump (LDU) between neighbouring samples that makes an edge.
+    pub depth_jump: f32,
+    /// Background pixel.
+    pub background: [u8; 4],
+    /// Line colour of new pieces.
+    pub new_line: [u8; 3],
+}
+
+/// Line colour of plain pieces.
+const LINE: [u8; 3] = [28, 28, 28];
+/// Line colour inside dark pieces, where a black line would not show.
+const LINE_ON_DARK: [u8; 3] = [105, 105, 105];
+/// Smallest cosine between two face normals of one piece without a line
+/// (about 37 degrees), in units of 127 squared.
+const CREASE_DOT: i32 = 12_900;
+
+fn is_dark(rgb: [u8; 3]) -> bool {
+    let [r, g, b] = rgb.map(u32::from);
+    (r * 30 + g * 59 + b * 11) / 100 < 60
+}
+
+fn fade(c: [u8; 3], f: u16) -> [u8; 3] {
+    c.map(|v| (u32::from(v) + ((255 - u32::from(v)) * u32::from(f) >> 8)) as u8)
+}
+
+/// The edge class between samples `i` and `j` (0 for no edge).
+#[inline]
+fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
+    let (pi, pj) = (s.piece[i], s.piece[j]);
+    let cls = |p: u32| looks.get(p as usize).map_or(class::PLAIN, |l| l.class);
+    match (pi == EMPTY, pj == EMPTY) {
+        (true, true) => 0,
+        (true, false) => cls(pj),
+        (false, true) => cls(pi),
+        (false, false) if pi != pj => cls(pi).max(cls(pj)),
+        (false, false) => {
+            let (fi, fj) = (s.face[i], s.face[j]);
+            let crease = fi[..3] != fj[..3] && {
+                let dot: i32 = (0..3)
+                    .map(|k| i32::from(fi[k] as i8) * i32::from(fj[k] as i8))
+                    .sum();
+                dot < CREASE_DOT
+            };
+            if crease || (s.depth[i] - s.depth[j]).abs() > jump {
+                cls(pi)
+            } else {
+                0
+            }
+        }
+    }
+}
+
+/// Composes pixel rectangle `rect` of `out` from `samples`.
+pub(crate) fn compose(
+    samples: &Samples,
+    looks: &[PieceLook],
+    style: &Style,
+    rect: PixelRect,
+    out: &mut RgbaImage,
+) {
+    let ss = samples.ss;
+    let (w, h) = (samples.w, samples.h);
+    let rect = PixelRect {
+        x1: rect.x1.min(out.width()),
+        y1: rect.y1.min(out.height()),
+        ..rect
+    };
+    if rect.is_empty() || w == 0 || h == 0 {
+        return;
+    }
+    let (sx0, sy0) = (rect.x0 as usize * ss, rect.y0 as usize * ss);
+    let (sx1, sy1) = (
+        (rect.x1 as usize * ss).min(w),
+        (rect.y1 as usize * ss).min(h),
+    );
+    let r = style.radius_new.max(style.radius);
+    let (ex0, ey0) = (sx0.saturating_sub(r), sy0.saturating_sub(r));
+    let (ex1, ey1) = ((sx1 + r).min(w), (sy1 + r).min(h));
+    let ew = ex1 - ex0;
+
+    // Edge classes over the region grown by the dilation radius.
+    let mut edges = vec![0u8; ew * (ey1 - ey0)];
+    for y in ey0..ey1 {
+        for x in ex0..ex1 {
+            let i = y * w + x;
+            let mut c = 0;
+            if x + 1 < w {
+                c = c.max(pair(samples, looks, i, i + 1, style.depth_jump));
+            }
+            if x > 0 {
+                c = c.max(pair(samples, looks, i, i - 1, style.depth_jump));
+            }
+            if y + 1 < h {
+                c = c.max(pair(samples, looks, i, i + w, style.depth_jump));
+            }
+            if y > 0 {
+                c = c.max(pair(samples, looks, i, i - w, style.depth_jump));
+            }
+            edges[(y - ey0) * ew + (x - ex0)] = c;
+        }
+    }
+    let lines = dilate(&edges, ew, ey1 - ey0, style.radius, style.radius_new);
+
+    let n = (ss * ss) as u32;
+    let old_line = fade(LINE, style.fade);
+    let old_line_on_dark = fade(LINE_ON_DARK, style.fade);
+    for py in rect.y0..rect.y1 {
+        for px in rect.x0..rect.x1 {
+            let (mut sr, mut sg, mut sb, mut opaque) = (0u32, 0u32, 0u32, 0u32);
+            for sy in py as usize * ss..(py as usize + 1) * ss {
+                for sx in px as usize * ss..(px as usize + 1) * ss {
+                    let (sx, sy) = (sx.min(w - 1), sy.min(h - 1));
+                    let i = sy * w + sx;
+                    let line = lines[(sy - ey0) * ew + (sx - ex0)];
+                    let p = samples.piece[i];
+                    let look = looks.get(p as usize);
+                    let rgb = if line != 0 {
+                        let dark = look.is_some_and(|l| is_dark(l.rgb));
+                        match line {
+                            class::OLD if dark => old_line_on_dark,
+                            class::OLD => old_line,
+                            _ if dark => LINE_ON_DARK,
+                            class::NEW => style.new_line,
+                            _ => LINE,
+                        }
+                    } else if let Some(l) = look {
+                        let shade = u32::from(samples.face[i][3]);
+                        let lit = l.rgb.map(|v| ((u32::from(v) * shade + 127) / 255) as u8);
+                        if l.class == class::OLD {
+                            fade(lit, style.fade)
+                        } else {
+                            lit
+                        }
+                    } else {
+                        let [r, g, b, a] = style.background;
+                        if a == 0 {
+                            continue;
+                        }
+                        [r, g, b]
+                    };
+                    sr += u32::from(rgb[0]);
+                    sg += u32::from(rgb[1]);
+                    sb += u32::from(rgb[2]);
+                    opaque += 1;
+                }
+            }
+            let px_out = if opaque == 0 {
+                let [r, g, b, _] = style.background;
+                [r, g, b, 0]
+            } else {
+                let avg = |s: u32| ((s + opaque / 2) / opaque) as u8;
+                [
+                    avg(sr),
+                    avg(sg),
+                    avg(sb),
+                    ((opaque * 255 + n / 2) / n) as u8,
+                ]
+            };
+            out.put_pixel(px, py, image::Rgba(px_out));
+        }
+    }
+}
+
+/// Thickens lines: each sample takes the highest class within `radius`
+/// (Chebyshev distance), and [`class::NEW`] within `radius_new`.
+fn dilate(edges: &[u8], w: usize, h: usize, radius: usize, radius_new: usize) -> Vec<u8> {
+    let pass = |src: &[u8], r: usize, keep: &dyn Fn(u8) -> u8| -> Vec<u8> {
+        if r == 0 {
+            return src.iter().map(|&c| keep(c)).collect();
+        }
+        let mut tmp = vec![0u8; w * h];
+        for y in 0..h {
+            let row = &src[y * w..(y + 1) * w];
+            for x in 0..w {
+                let (a, b) = (x.saturating_sub(r), (x + r + 1).min(w));
+                tmp[y * w + x] = row[a..b].iter().map(|&c| keep(c)).max().unwrap_or(0);
+            }
+        }
+        let mut out = vec![0u8; w * h];
+        for y in 0..h {
+            let (a, b) = (y.saturating_sub(r), (y + r + 1).min(h));
+            for x in 0..w {
+                out[y * w + x] = (a..b).map(|yy| tmp[yy * w + x]).max().unwrap_or(0);
+            }
+        }
+        out
+    };
+    let all = pass(edges, radius, &|c| c);
+    if radius_new <= radius {
+        return all;
+    }
+    let new = pass(edges, radius_new, &|c| if c == class::NEW { c } else { 0 });
+    all.iter().zip(&new).map(|(&a, &b)| a.max(b)).collect()
+}
+
+/// The line colour of new pieces for an accent colour, or the plain line.
+pub(crate) fn new_line(accent: Option<Rgb<u8>>) -> [u8; 3] {
+    accent.map_or(LINE, |c| c.0)
+}
