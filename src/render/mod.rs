@@ -296,3 +296,6 @@ pub enum RenderError {
         source: std::io::Error,
     },
 }
+
+#[cfg(test)]
+mod tests;
