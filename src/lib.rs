@@ -23,6 +23,7 @@
 
 pub mod assembly;
 pub mod catalog;
+pub mod export;
 pub mod fsutil;
 pub mod geom;
 pub mod grammar;
