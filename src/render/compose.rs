@@ -92,7 +92,9 @@ fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
                 dot < CREASE_DOT
             };
             if crease || (s.depth[i] - s.depth[j]).abs() > jump {
-                cls(pi)
+                // Lines inside a new piece keep the plain weight: thick
+                // lines are for its outline only.
+                cls(pi).min(class::PLAIN)
             } else {
                 0
             }
@@ -128,28 +130,55 @@ pub(crate) fn compose(
     let (ex1, ey1) = ((sx1 + r).min(w), (sy1 + r).min(h));
     let ew = ex1 - ex0;
 
-    // Edge classes over the region grown by the dilation radius.
-    let mut edges = vec![0u8; ew * (ey1 - ey0)];
+    // Edge classes over the region grown by the dilation radius: each
+    // pair of neighbours is judged once, across (`across[k]` between
+    // samples k and k + 1 of a row) and down (`down[k]` between rows).
+    let eh = ey1 - ey0;
+    let mut across = vec![0u8; ew * eh];
+    let mut down = vec![0u8; ew * eh];
     for y in ey0..ey1 {
         for x in ex0..ex1 {
             let i = y * w + x;
-            let mut c = 0;
+            let k = (y - ey0) * ew + (x - ex0);
             if x + 1 < w {
-                c = c.max(pair(samples, looks, i, i + 1, style.depth_jump));
-            }
-            if x > 0 {
-                c = c.max(pair(samples, looks, i, i - 1, style.depth_jump));
+                across[k] = pair(samples, looks, i, i + 1, style.depth_jump);
             }
             if y + 1 < h {
-                c = c.max(pair(samples, looks, i, i + w, style.depth_jump));
+                down[k] = pair(samples, looks, i, i + w, style.depth_jump);
             }
-            if y > 0 {
-                c = c.max(pair(samples, looks, i, i - w, style.depth_jump));
-            }
-            edges[(y - ey0) * ew + (x - ex0)] = c;
         }
     }
-    let lines = dilate(&edges, ew, ey1 - ey0, style.radius, style.radius_new);
+    let mut edges = vec![0u8; ew * eh];
+    for y in ey0..ey1 {
+        for x in ex0..ex1 {
+            let k = (y - ey0) * ew + (x - ex0);
+            let mut c = across[k].max(down[k]);
+            if x > ex0 {
+                c = c.max(across[k - 1]);
+            } else if x > 0 {
+                c = c.max(pair(
+                    samples,
+                    looks,
+                    y * w + x,
+                    y * w + x - 1,
+                    style.depth_jump,
+                ));
+            }
+            if y > ey0 {
+                c = c.max(down[k - ew]);
+            } else if y > 0 {
+                c = c.max(pair(
+                    samples,
+                    looks,
+                    y * w + x,
+                    (y - 1) * w + x,
+                    style.depth_jump,
+                ));
+            }
+            edges[k] = c;
+        }
+    }
+    let lines = dilate(edges, ew, eh, style.radius, style.radius_new);
 
     let n = (ss * ss) as u32;
     let old_line = fade(LINE, style.fade);
@@ -213,34 +242,40 @@ pub(crate) fn compose(
 
 /// Thickens lines: each sample takes the highest class within `radius`
 /// (Chebyshev distance), and [`class::NEW`] within `radius_new`.
-fn dilate(edges: &[u8], w: usize, h: usize, radius: usize, radius_new: usize) -> Vec<u8> {
-    let pass = |src: &[u8], r: usize, keep: &dyn Fn(u8) -> u8| -> Vec<u8> {
-        if r == 0 {
-            return src.iter().map(|&c| keep(c)).collect();
-        }
-        let mut tmp = vec![0u8; w * h];
-        for y in 0..h {
-            let row = &src[y * w..(y + 1) * w];
-            for x in 0..w {
-                let (a, b) = (x.saturating_sub(r), (x + r + 1).min(w));
-                tmp[y * w + x] = row[a..b].iter().map(|&c| keep(c)).max().unwrap_or(0);
-            }
-        }
-        let mut out = vec![0u8; w * h];
-        for y in 0..h {
-            let (a, b) = (y.saturating_sub(r), (y + r + 1).min(h));
-            for x in 0..w {
-                out[y * w + x] = (a..b).map(|yy| tmp[yy * w + x]).max().unwrap_or(0);
-            }
-        }
-        out
-    };
-    let all = pass(edges, radius, &|c| c);
-    if radius_new <= radius {
+fn dilate(edges: Vec<u8>, w: usize, h: usize, radius: usize, radius_new: usize) -> Vec<u8> {
+    let all = max_filter(edges.clone(), w, h, radius);
+    if radius_new <= radius || !edges.contains(&class::NEW) {
         return all;
     }
-    let new = pass(edges, radius_new, &|c| if c == class::NEW { c } else { 0 });
+    let new: Vec<u8> = edges
+        .iter()
+        .map(|&c| if c == class::NEW { c } else { 0 })
+        .collect();
+    let new = max_filter(new, w, h, radius_new);
     all.iter().zip(&new).map(|(&a, &b)| a.max(b)).collect()
+}
+
+/// The maximum over each `(2r + 1)` square, separably.
+fn max_filter(src: Vec<u8>, w: usize, h: usize, r: usize) -> Vec<u8> {
+    if r == 0 {
+        return src;
+    }
+    let mut tmp = vec![0u8; w * h];
+    for y in 0..h {
+        let row = &src[y * w..(y + 1) * w];
+        for x in 0..w {
+            let (a, b) = (x.saturating_sub(r), (x + r + 1).min(w));
+            tmp[y * w + x] = row[a..b].iter().copied().max().unwrap_or(0);
+        }
+    }
+    let mut out = vec![0u8; w * h];
+    for y in 0..h {
+        let (a, b) = (y.saturating_sub(r), (y + r + 1).min(h));
+        for x in 0..w {
+            out[y * w + x] = (a..b).map(|yy| tmp[yy * w + x]).max().unwrap_or(0);
+        }
+    }
+    out
 }
 
 /// The line colour of new pieces for an accent colour, or the plain line.

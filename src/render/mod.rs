@@ -70,10 +70,14 @@ mod raster;
 mod scene;
 mod steps;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use image::Rgb;
+use glam::Affine3A;
+use image::{Rgb, RgbaImage};
 use thiserror::Error;
+
+use crate::assembly::{Assembly, Step};
+use crate::catalog::{Color, PartKind};
 
 pub use camera::{Camera, View};
 pub use raster::PixelRect;
@@ -84,6 +88,69 @@ use compose::Style;
 
 /// Largest image side, in pixels.
 pub const MAX_SIZE: u32 = 8192;
+
+/// Side in pixels of [`part_image`]'s square pictures.
+pub const PART_IMAGE_SIZE: u32 = 128;
+
+/// A step renderer for `assembly`, its camera fitted to the finished
+/// model: every image it draws shares one projection and scale.
+pub fn renderer(assembly: &Assembly, opts: &RenderOptions) -> Result<StepRenderer, RenderError> {
+    StepRenderer::new(Scene::from_assembly(assembly), opts)
+}
+
+/// The step images of `assembly`, in order, each `(step, image)`.
+///
+/// Step `k` shows the pieces of steps `1..=k`, those of step `k`
+/// highlighted (see [`Highlight`]). An empty assembly gives no images.
+pub fn steps(
+    assembly: &Assembly,
+    opts: &RenderOptions,
+) -> Result<StepImages<'static>, RenderError> {
+    Ok(renderer(assembly, opts)?.into_images())
+}
+
+/// Writes the step images of `assembly` into `dir` (created if missing) as
+/// `step-001.png`, `step-002.png`, ..., each atomically, in parallel, and
+/// returns their paths in step order.
+pub fn write_steps(
+    assembly: &Assembly,
+    opts: &RenderOptions,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, RenderError> {
+    renderer(assembly, opts)?.write_steps(dir)
+}
+
+/// The finished model, every piece plain. An empty assembly gives a blank
+/// image.
+pub fn model_image(assembly: &Assembly, opts: &RenderOptions) -> Result<RgbaImage, RenderError> {
+    Ok(renderer(assembly, opts)?.model_image())
+}
+
+/// One part alone in `color`, [`PART_IMAGE_SIZE`] pixels square on white,
+/// for parts lists. Every part is seen from the same view, scaled to fill
+/// the picture.
+pub fn part_image(part: PartKind, color: Color) -> RgbaImage {
+    let opts = RenderOptions::part_default();
+    let mut scene = Scene::new();
+    scene.add_part(part, Affine3A::IDENTITY, color, Step(1));
+    // The part defaults are in range, so this cannot fail; fall back to a
+    // blank picture rather than panic if they ever were not.
+    StepRenderer::new(scene, &opts).map_or_else(
+        |_| RgbaImage::from_pixel(PART_IMAGE_SIZE, PART_IMAGE_SIZE, image::Rgba([255; 4])),
+        |r| r.model_image(),
+    )
+}
+
+/// [`part_image`] with other options (size, view, background).
+pub fn part_image_with(
+    part: PartKind,
+    color: Color,
+    opts: &RenderOptions,
+) -> Result<RgbaImage, RenderError> {
+    let mut scene = Scene::new();
+    scene.add_part(part, Affine3A::IDENTITY, color, Step(1));
+    Ok(StepRenderer::new(scene, opts)?.model_image())
+}
 
 /// What lies behind the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -150,6 +217,18 @@ impl Default for RenderOptions {
 }
 
 impl RenderOptions {
+    /// The options of [`part_image`]: [`PART_IMAGE_SIZE`] square, 3 x 3
+    /// samples a pixel, a small margin.
+    pub fn part_default() -> Self {
+        RenderOptions {
+            width: PART_IMAGE_SIZE,
+            height: PART_IMAGE_SIZE,
+            supersample: 3,
+            margin: 6,
+            ..RenderOptions::default()
+        }
+    }
+
     /// With this image size in pixels.
     pub fn with_size(self, width: u32, height: u32) -> Self {
         RenderOptions {

@@ -206,14 +206,24 @@ impl Samples {
         for y in y0..y1 {
             let py = y as f32 + 0.5;
             let row = y * self.w;
+            // Each edge value is evaluated exactly, in the same order for
+            // both triangles of a shared edge (so they see exact negations);
+            // a row's covered samples are contiguous, so leave the row once
+            // past them.
+            let (r0, r1, r2) = (e0.1 * py + e0.2, e1.1 * py + e1.2, e2.1 * py + e2.2);
+            let mut entered = false;
             for x in x0..x1 {
                 let px = x as f32 + 0.5;
-                let w0 = e0.0 * px + e0.1 * py + e0.2;
-                let w1 = e1.0 * px + e1.1 * py + e1.2;
-                let w2 = e2.0 * px + e2.1 * py + e2.2;
+                let w0 = e0.0 * px + r0;
+                let w1 = e1.0 * px + r1;
+                let w2 = e2.0 * px + r2;
                 if outside(w0, e0.3) || outside(w1, e1.3) || outside(w2, e2.3) {
+                    if entered {
+                        break;
+                    }
                     continue;
                 }
+                entered = true;
                 let z = (w0 * a.z + w1 * b.z + w2 * c.z) * inv;
                 let i = row + x;
                 if z < self.depth[i] {

@@ -8,10 +8,12 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 use image::Rgb;
 
-use crate::assembly::Step;
+use crate::assembly::{Assembly, Step};
+use crate::catalog::{Color, PartKind};
+use crate::export::partmesh::{part_mesh, piece_transform, PartMesh};
 
 /// One triangle of a piece, in world coordinates (LDU).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,6 +84,34 @@ impl Scene {
         self.pieces.len() - 1
     }
 
+    /// The scene of an assembly: every piece's part mesh
+    /// ([`part_mesh`]) placed exactly as its `.ldr` line places it
+    /// ([`piece_transform`]), in its colour and step.
+    pub fn from_assembly(assembly: &Assembly) -> Scene {
+        let mut scene = Scene::new();
+        for p in &assembly.pieces {
+            let at = piece_transform(&p.placement, assembly.layer_ldu);
+            scene.add_part(p.placement.part, at, p.color, p.step);
+        }
+        scene
+    }
+
+    /// Adds one part, its mesh moved by `transform` (a rotation and a
+    /// translation, as [`piece_transform`] gives), and returns its index.
+    pub fn add_part(
+        &mut self,
+        part: PartKind,
+        transform: Affine3A,
+        color: Color,
+        step: Step,
+    ) -> usize {
+        self.add_piece(
+            Rgb(color.rgb()),
+            step,
+            mesh_triangles(part_mesh(part), transform),
+        )
+    }
+
     /// Every piece, in the order added.
     pub fn pieces(&self) -> &[ScenePiece] {
         &self.pieces
@@ -103,6 +133,25 @@ impl Scene {
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
     }
+}
+
+/// The triangles of `mesh` moved by `transform`, each with the mean of its
+/// vertex normals (a stud's facet gets its own radial direction, a flat face
+/// its face normal), or the winding's normal where the mesh has none.
+fn mesh_triangles(mesh: &PartMesh, transform: Affine3A) -> impl Iterator<Item = Triangle> + '_ {
+    mesh.indices.chunks_exact(3).filter_map(move |t| {
+        let corner = |k: usize| mesh.positions.get(t[k] as usize).map(|&p| Vec3::from(p));
+        let positions = [corner(0)?, corner(1)?, corner(2)?].map(|p| transform.transform_point3(p));
+        let winding = Triangle::from_winding(positions);
+        let mean: Option<Vec3> = (0..3)
+            .map(|k| mesh.normals.get(t[k] as usize).map(|&n| Vec3::from(n)))
+            .sum();
+        let normal = mean
+            .map(|n| transform.transform_vector3(n).normalize_or_zero())
+            .filter(|n| n.dot(winding.normal) > 0.0)
+            .unwrap_or(winding.normal);
+        Some(Triangle { positions, normal })
+    })
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! width. The result is the same, byte for byte, as drawing step `k` from
 //! scratch.
 //!
-//! [`StepRenderer::write_steps`] cuts the steps into runs, one or two per
+//! [`StepRenderer::write_steps`] cuts the steps into runs, one per
 //! thread, and renders the runs in parallel with rayon, each run from its
 //! own buffers.
 
@@ -127,6 +127,27 @@ impl StepRenderer {
         })
     }
 
+    /// The pixel rectangles to compose again when step number `n` follows
+    /// step `n - 1`: around each piece of both steps, or one box around
+    /// them all when that is smaller.
+    fn dirty_rects(&self, n: usize) -> Vec<PixelRect> {
+        let (w, h) = (self.camera.width(), self.camera.height());
+        let area = |r: &PixelRect| u64::from(r.x1 - r.x0) * u64::from(r.y1 - r.y0);
+        let rects: Vec<PixelRect> = [n.wrapping_sub(1), n]
+            .into_iter()
+            .filter_map(|m| self.steps.get(m))
+            .flat_map(|(_, range)| self.order[range.clone()].iter())
+            .map(|&i| self.rects[i].grown(self.reach, w, h))
+            .filter(|r| !r.is_empty())
+            .collect();
+        let union = rects.iter().fold(PixelRect::EMPTY, |a, &r| a.union(r));
+        if rects.iter().map(area).sum::<u64>() > area(&union) {
+            vec![union]
+        } else {
+            rects
+        }
+    }
+
     /// The screen box (pixels) of scene piece `i`.
     pub fn piece_rect(&self, i: usize) -> PixelRect {
         self.rects.get(i).copied().unwrap_or(PixelRect::EMPTY)
@@ -237,7 +258,7 @@ impl StepRenderer {
             .iter()
             .map(|(s, _)| dir.join(format!("step-{:0digits$}.png", s.0)))
             .collect();
-        let runs = (rayon::current_num_threads() * 2).clamp(1, n.max(1));
+        let runs = rayon::current_num_threads().clamp(1, n.max(1));
         let per_run = n.div_ceil(runs).max(1);
         let ranges: Vec<Range<usize>> = (0..n)
             .step_by(per_run)
@@ -317,10 +338,7 @@ impl Iterator for StepImages<'_> {
         match &mut self.samples {
             Some(samples) => {
                 r.draw_step(samples, n);
-                let reach = r.reach;
-                let (w, h) = (self.image.width(), self.image.height());
-                for m in [n - 1, n] {
-                    let rect = r.step_rect(m).grown(reach, w, h);
+                for rect in r.dirty_rects(n) {
                     compose(samples, &looks, &r.style, rect, &mut self.image);
                 }
             }

@@ -102,7 +102,10 @@ fn incremental_steps_equal_steps_drawn_from_scratch() {
         assert_eq!(steps.len(), 4);
         for (n, (step, img)) in steps.iter().enumerate() {
             assert_eq!(*step, Step(n as u32 + 1));
-            assert!(*img == r.step_image(n).unwrap(), "step {step:?} {highlight:?}");
+            assert!(
+                *img == r.step_image(n).unwrap(),
+                "step {step:?} {highlight:?}"
+            );
         }
         // A run starting midway agrees too.
         let tail: Vec<_> = r.images_in(2..4).collect();
@@ -139,7 +142,10 @@ fn a_step_changes_only_pixels_near_its_pieces() {
         let new = r.step_rect(n).grown(2, w, h);
         let faded = r.step_rect(n - 1).grown(2, w, h);
         for (x, y) in changed(&imgs[n - 1], &imgs[n]) {
-            assert!(new.contains(x, y) || faded.contains(x, y), "step {n}: ({x}, {y})");
+            assert!(
+                new.contains(x, y) || faded.contains(x, y),
+                "step {n}: ({x}, {y})"
+            );
         }
     }
 }
@@ -169,7 +175,15 @@ fn parallel_files_match_the_sequential_images() {
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names, ["step-001.png", "step-002.png", "step-003.png", "step-004.png"]);
+    assert_eq!(
+        names,
+        [
+            "step-001.png",
+            "step-002.png",
+            "step-003.png",
+            "step-004.png"
+        ]
+    );
     for ((_, img), path) in r.images().zip(&paths) {
         assert_eq!(std::fs::read(path).unwrap(), png(&img));
     }

@@ -1,0 +1,68 @@
+//! Builds a mesh and draws its instruction images, timing the renderer.
+//!
+//! ```text
+//! cargo run --release --example render_steps -- MESH OUT_DIR [--studs N] [--slopes] [--plates]
+//! ```
+//!
+//! Writes `OUT_DIR/model.png` and `OUT_DIR/steps/step-NNN.png`, and prints
+//! how many step images a second the renderer made.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use brickwright::pipeline::{self, BuildOptions, Silent};
+use brickwright::render::{self, RenderOptions};
+use brickwright::voxel::Sizing;
+
+fn main() -> Result<()> {
+    let mut args = std::env::args().skip(1);
+    let (Some(mesh), Some(out)) = (args.next(), args.next()) else {
+        bail!("usage: render_steps MESH OUT_DIR [--studs N] [--slopes] [--plates]");
+    };
+    let out = PathBuf::from(out);
+    let build_dir = tempfile::tempdir()?;
+    let mut opts = BuildOptions::new(mesh);
+    opts.out_dir = build_dir.path().to_path_buf();
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--studs" => {
+                let n = args.next().context("--studs needs a number")?;
+                opts.sizing = Sizing::Studs(n.parse().context("--studs needs a number")?);
+            }
+            "--slopes" => opts.slopes = true,
+            "--plates" => opts.plates = true,
+            _ => bail!("unknown argument {a}"),
+        }
+    }
+    let t = Instant::now();
+    let built = pipeline::build(&opts, &Silent)?;
+    let asm = built.assembly;
+    eprintln!(
+        "built {} pieces in {} steps in {:.2} s",
+        asm.pieces.len(),
+        asm.step_count(),
+        t.elapsed().as_secs_f64()
+    );
+
+    let ropts = RenderOptions::default();
+    let t = Instant::now();
+    let renderer = render::renderer(&asm, &ropts)?;
+    let setup = t.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&out)?;
+    renderer.write_png_file(&renderer.model_image(), &out.join("model.png"))?;
+    let t = Instant::now();
+    let paths = renderer.write_steps(&out.join("steps"))?;
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!(
+        "scene + camera {:.3} s; {} step images of {}x{} in {:.3} s: {:.1} images/s ({} threads)",
+        setup,
+        paths.len(),
+        ropts.width,
+        ropts.height,
+        secs,
+        paths.len() as f64 / secs.max(1e-9),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
