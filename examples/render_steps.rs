@@ -1,7 +1,9 @@
-//! Builds a mesh and draws its instruction images, timing the renderer.
+//! Builds a mesh (or reads an `.ldr` model) and draws its instruction
+//! images, timing the renderer.
 //!
 //! ```text
 //! cargo run --release --example render_steps -- MESH OUT_DIR [--studs N] [--slopes] [--plates]
+//! cargo run --release --example render_steps -- MODEL.ldr OUT_DIR
 //! ```
 //!
 //! Writes `OUT_DIR/model.png` and `OUT_DIR/steps/step-NNN.png`, and prints
@@ -11,6 +13,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use brickwright::ldraw;
 use brickwright::pipeline::{self, BuildOptions, Silent};
 use brickwright::render::{self, RenderOptions};
 use brickwright::voxel::Sizing;
@@ -36,10 +39,17 @@ fn main() -> Result<()> {
         }
     }
     let t = Instant::now();
-    let built = pipeline::build(&opts, &Silent)?;
-    let asm = built.assembly;
+    let asm = if opts
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ldr"))
+    {
+        ldraw::to_assembly(&ldraw::read_ldr(&opts.input)?)?
+    } else {
+        pipeline::build(&opts, &Silent)?.assembly
+    };
     eprintln!(
-        "built {} pieces in {} steps in {:.2} s",
+        "{} pieces in {} steps in {:.2} s",
         asm.pieces.len(),
         asm.step_count(),
         t.elapsed().as_secs_f64()

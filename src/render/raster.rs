@@ -211,8 +211,24 @@ impl Samples {
             // a row's covered samples are contiguous, so leave the row once
             // past them.
             let (r0, r1, r2) = (e0.1 * py + e0.2, e1.1 * py + e1.2, e2.1 * py + e2.2);
+            // Narrow the row to where the edges cross it (with a sample of
+            // slack each side; the exact tests below decide), so long thin
+            // triangles cost their area, not their bounding box.
+            let (mut lo, mut hi) = (x0 as f32, x1 as f32);
+            for (ea, r) in [(e0.0, r0), (e1.0, r1), (e2.0, r2)] {
+                let cross = -r / ea - 0.5;
+                if ea > 0.0 {
+                    lo = lo.max(cross.floor() - 1.0);
+                } else if ea < 0.0 {
+                    hi = hi.min(cross.ceil() + 2.0);
+                }
+            }
+            if lo >= hi {
+                continue;
+            }
+            let (xa, xb) = (lo as usize, (hi as usize).min(x1));
             let mut entered = false;
-            for x in x0..x1 {
+            for x in xa..xb {
                 let px = x as f32 + 0.5;
                 let w0 = e0.0 * px + r0;
                 let w1 = e1.0 * px + r1;
