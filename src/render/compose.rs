@@ -70,7 +70,7 @@ fn is_dark(rgb: [u8; 3]) -> bool {
 }
 
 fn fade(c: [u8; 3], f: u16) -> [u8; 3] {
-    c.map(|v| (u32::from(v) + ((255 - u32::from(v)) * u32::from(f) >> 8)) as u8)
+    c.map(|v| (u32::from(v) + (((255 - u32::from(v)) * u32::from(f)) >> 8)) as u8)
 }
 
 /// The edge class between samples `i` and `j` (0 for no edge).
