@@ -74,31 +74,34 @@ fn fade(c: [u8; 3], f: u16) -> [u8; 3] {
 }
 
 /// The edge class between samples `i` and `j` (0 for no edge).
-#[inline]
+#[inline(always)]
 fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
     let (pi, pj) = (s.piece[i], s.piece[j]);
     let cls = |p: u32| looks.get(p as usize).map_or(class::PLAIN, |l| l.class);
-    match (pi == EMPTY, pj == EMPTY) {
-        (true, true) => 0,
-        (true, false) => cls(pj),
-        (false, true) => cls(pi),
-        (false, false) if pi != pj => cls(pi).max(cls(pj)),
-        (false, false) => {
-            let (fi, fj) = (s.face[i], s.face[j]);
-            let crease = fi[..3] != fj[..3] && {
-                let dot: i32 = (0..3)
-                    .map(|k| i32::from(fi[k] as i8) * i32::from(fj[k] as i8))
-                    .sum();
-                dot < CREASE_DOT
-            };
-            if crease || (s.depth[i] - s.depth[j]).abs() > jump {
-                // Lines inside a new piece keep the plain weight: thick
-                // lines are for its outline only.
-                cls(pi).min(class::PLAIN)
-            } else {
-                0
-            }
+    if pi == pj {
+        // The common case: inside one face of one piece, or background.
+        if pi == EMPTY {
+            return 0;
         }
+        let (fi, fj) = (s.face[i], s.face[j]);
+        let crease = fi[..3] != fj[..3] && {
+            let dot: i32 = (0..3)
+                .map(|k| i32::from(fi[k] as i8) * i32::from(fj[k] as i8))
+                .sum();
+            dot < CREASE_DOT
+        };
+        return if crease || (s.depth[i] - s.depth[j]).abs() > jump {
+            // Lines inside a new piece keep the plain weight: thick
+            // lines are for its outline only.
+            cls(pi).min(class::PLAIN)
+        } else {
+            0
+        };
+    }
+    match (pi == EMPTY, pj == EMPTY) {
+        (true, _) => cls(pj),
+        (_, true) => cls(pi),
+        _ => cls(pi).max(cls(pj)),
     }
 }
 
@@ -257,22 +260,32 @@ fn dilate(edges: Vec<u8>, w: usize, h: usize, radius: usize, radius_new: usize) 
 
 /// The maximum over each `(2r + 1)` square, separably.
 fn max_filter(src: Vec<u8>, w: usize, h: usize, r: usize) -> Vec<u8> {
-    if r == 0 {
+    if r == 0 || w == 0 {
         return src;
     }
-    let mut tmp = vec![0u8; w * h];
-    for y in 0..h {
-        let row = &src[y * w..(y + 1) * w];
-        for x in 0..w {
-            let (a, b) = (x.saturating_sub(r), (x + r + 1).min(w));
-            tmp[y * w + x] = row[a..b].iter().copied().max().unwrap_or(0);
+    // Across: each element takes the max of its neighbours up to r away.
+    let mut tmp = src.clone();
+    for (out, row) in tmp.chunks_exact_mut(w).zip(src.chunks_exact(w)) {
+        for d in 1..=r.min(w - 1) {
+            for x in 0..w - d {
+                out[x] = out[x].max(row[x + d]);
+                out[x + d] = out[x + d].max(row[x]);
+            }
         }
     }
-    let mut out = vec![0u8; w * h];
+    // Down: whole rows at a time.
+    let mut out = tmp.clone();
     for y in 0..h {
         let (a, b) = (y.saturating_sub(r), (y + r + 1).min(h));
-        for x in 0..w {
-            out[y * w + x] = (a..b).map(|yy| tmp[yy * w + x]).max().unwrap_or(0);
+        for yy in a..b {
+            if yy == y {
+                continue;
+            }
+            let dst = &mut out[y * w..(y + 1) * w];
+            let src_row = &tmp[yy * w..(yy + 1) * w];
+            for (o, &v) in dst.iter_mut().zip(src_row) {
+                *o = (*o).max(v);
+            }
         }
     }
     out

@@ -291,11 +291,10 @@ pub fn write_png(img: &RgbaImage, alpha: bool, w: &mut dyn Write) -> io::Result<
     let res = if alpha {
         enc.write_image(img.as_raw(), width, height, image::ExtendedColorType::Rgba8)
     } else {
-        let rgb: Vec<u8> = img
-            .as_raw()
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect();
+        let mut rgb = Vec::with_capacity(img.as_raw().len() / 4 * 3);
+        for p in img.as_raw().chunks_exact(4) {
+            rgb.extend_from_slice(&p[..3]);
+        }
         enc.write_image(&rgb, width, height, image::ExtendedColorType::Rgb8)
     };
     res.map_err(io::Error::other)
