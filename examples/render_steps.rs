@@ -2,7 +2,7 @@
 //! images, timing the renderer.
 //!
 //! ```text
-//! cargo run --release --example render_steps -- MESH OUT_DIR [--studs N] [--slopes] [--plates]
+//! cargo run --release --example render_steps -- MESH OUT_DIR [--studs N] [--slopes] [--plates] [--size WxH] [--no-steps]
 //! cargo run --release --example render_steps -- MODEL.ldr OUT_DIR
 //! ```
 //!
@@ -21,18 +21,26 @@ use brickwright::voxel::Sizing;
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
     let (Some(mesh), Some(out)) = (args.next(), args.next()) else {
-        bail!("usage: render_steps MESH OUT_DIR [--studs N] [--slopes] [--plates]");
+        bail!("usage: render_steps MESH OUT_DIR [--studs N] [--slopes] [--plates] [--size WxH] [--no-steps]");
     };
     let out = PathBuf::from(out);
     let build_dir = tempfile::tempdir()?;
     let mut opts = BuildOptions::new(mesh);
     opts.out_dir = build_dir.path().to_path_buf();
+    let mut ropts = RenderOptions::default();
+    let mut steps = true;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--studs" => {
                 let n = args.next().context("--studs needs a number")?;
                 opts.sizing = Sizing::Studs(n.parse().context("--studs needs a number")?);
             }
+            "--size" => {
+                let v = args.next().context("--size needs WIDTHxHEIGHT")?;
+                let (w, h) = v.split_once('x').context("--size needs WIDTHxHEIGHT")?;
+                ropts = ropts.with_size(w.parse()?, h.parse()?);
+            }
+            "--no-steps" => steps = false,
             "--slopes" => opts.slopes = true,
             "--plates" => opts.plates = true,
             _ => bail!("unknown argument {a}"),
@@ -55,12 +63,14 @@ fn main() -> Result<()> {
         t.elapsed().as_secs_f64()
     );
 
-    let ropts = RenderOptions::default();
     let t = Instant::now();
     let renderer = render::renderer(&asm, &ropts)?;
     let setup = t.elapsed().as_secs_f64();
     std::fs::create_dir_all(&out)?;
     renderer.write_png_file(&renderer.model_image(), &out.join("model.png"))?;
+    if !steps {
+        return Ok(());
+    }
     let t = Instant::now();
     let paths = renderer.write_steps(&out.join("steps"))?;
     let secs = t.elapsed().as_secs_f64();

@@ -177,6 +177,11 @@ impl Camera {
         self.right
     }
 
+    /// The world direction of the image's +y (down the page).
+    pub fn down(&self) -> Vec3 {
+        self.down
+    }
+
     /// Pixels per LDU.
     pub fn scale(&self) -> f32 {
         self.scale

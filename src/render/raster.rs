@@ -150,10 +150,22 @@ impl Samples {
     ) {
         let eye = camera.toward_eye();
         let ss = self.ss as f32;
+        let per_sample = camera.scale() * ss;
         for t in scene.piece_triangles(index) {
             if t.normal.dot(eye) <= 1e-4 {
                 continue;
             }
+            // Depth across the screen follows the triangle's plane, taken
+            // from its world corners: stable even for long slivers, where
+            // barycentric weights lose precision.
+            let [a, b, c] = t.positions;
+            let g = (b - a).cross(c - a);
+            let toward = g.dot(eye);
+            if toward.abs() <= 1e-6 * g.length() {
+                continue;
+            }
+            let slope =
+                Vec2::new(g.dot(camera.right()), g.dot(camera.down())) / (toward * per_sample);
             let p = t.positions.map(|v| {
                 let q = camera.project(v);
                 Vec3::new(q.x * ss, q.y * ss, q.z)
@@ -161,13 +173,15 @@ impl Samples {
             let n = t.normal;
             let q = |c: f32| (c.clamp(-1.0, 1.0) * 127.0).round() as i8 as u8;
             let face = [q(n.x), q(n.y), q(n.z), light.shade(n)];
-            self.fill(p, index as u32, face);
+            self.fill(p, slope, index as u32, face);
         }
     }
 
-    /// Fills one triangle given in sample coordinates (x, y) with depth z.
-    fn fill(&mut self, p: [Vec3; 3], piece: u32, face: [u8; 4]) {
+    /// Fills one triangle given in sample coordinates (x, y) with depth z,
+    /// the depth growing by `slope` per sample along x and y.
+    fn fill(&mut self, p: [Vec3; 3], slope: Vec2, piece: u32, face: [u8; 4]) {
         let [mut a, mut b, c] = p;
+        let (za, zx, zy) = (a.z - slope.x * a.x - slope.y * a.y, slope.x, slope.y);
         let area = edge(a.truncate(), b.truncate(), c.truncate());
         if !area.is_finite() || area.abs() < 1e-6 {
             return;
@@ -177,7 +191,6 @@ impl Samples {
         if area < 0.0 {
             std::mem::swap(&mut a, &mut b);
         }
-        let area = area.abs();
         let (a2, b2, c2) = (a.truncate(), b.truncate(), c.truncate());
         let lo = a2.min(b2).min(c2);
         let hi = a2.max(b2).max(c2);
@@ -202,7 +215,6 @@ impl Samples {
         let e0 = setup(b2, c2);
         let e1 = setup(c2, a2);
         let e2 = setup(a2, b2);
-        let inv = 1.0 / area;
         for y in y0..y1 {
             let py = y as f32 + 0.5;
             let row = y * self.w;
@@ -215,12 +227,20 @@ impl Samples {
             // slack each side; the exact tests below decide), so long thin
             // triangles cost their area, not their bounding box.
             let (mut lo, mut hi) = (x0 as f32, x1 as f32);
-            for (ea, r) in [(e0.0, r0), (e1.0, r1), (e2.0, r2)] {
+            for (e, r) in [(e0, r0), (e1, r1), (e2, r2)] {
+                let ea = e.0;
+                if ea == 0.0 {
+                    continue;
+                }
+                // Where the edge crosses the row, give or take the rounding
+                // of `r` divided by a possibly small slope (nearly
+                // horizontal edges), plus a sample.
                 let cross = -r / ea - 0.5;
+                let slack = 1.0 + (e.1.abs() * py + e.2.abs() + ea.abs() * hi) * 1e-6 / ea.abs();
                 if ea > 0.0 {
-                    lo = lo.max(cross.floor() - 1.0);
-                } else if ea < 0.0 {
-                    hi = hi.min(cross.ceil() + 2.0);
+                    lo = lo.max((cross - slack).floor());
+                } else {
+                    hi = hi.min((cross + slack).ceil() + 1.0);
                 }
             }
             if lo >= hi {
@@ -240,7 +260,7 @@ impl Samples {
                     continue;
                 }
                 entered = true;
-                let z = (w0 * a.z + w1 * b.z + w2 * c.z) * inv;
+                let z = za + zx * px + zy * py;
                 let i = row + x;
                 if z < self.depth[i] {
                     self.depth[i] = z;
@@ -338,12 +358,12 @@ mod tests {
             Vec3::new(2.2, 13.9, 0.0),
         ];
         let mut t = Samples::new(16, 16, 1);
-        t.fill([q[0], q[1], q[2]], 0, [0; 4]);
+        t.fill([q[0], q[1], q[2]], Vec2::ZERO, 0, [0; 4]);
         let mut u = Samples::new(16, 16, 1);
-        u.fill([q[0], q[2], q[3]], 1, [0; 4]);
+        u.fill([q[0], q[2], q[3]], Vec2::ZERO, 1, [0; 4]);
         let mut both = Samples::new(16, 16, 1);
-        both.fill([q[0], q[1], q[2]], 0, [0; 4]);
-        both.fill([q[0], q[2], q[3]], 1, [0; 4]);
+        both.fill([q[0], q[1], q[2]], Vec2::ZERO, 0, [0; 4]);
+        both.fill([q[0], q[2], q[3]], Vec2::ZERO, 1, [0; 4]);
         for i in 0..256 {
             let (a, b) = (t.piece[i] != EMPTY, u.piece[i] != EMPTY);
             assert!(!(a && b), "sample {i} covered twice");

@@ -245,3 +245,43 @@ fn every_quarter_turn_shows_the_whole_model() {
         }
     }
 }
+
+#[test]
+fn long_sliver_triangles_leave_no_specks() {
+    // Regression: a face cut into a fan of slivers (as part meshes cut
+    // faces to avoid T-junctions) once showed stray line dots, its depth
+    // interpolated too coarsely. A flat square facing the viewer, fanned
+    // from one corner to 60 points along the far edges:
+    let (lo, hi) = (-100.0_f32, 100.0_f32);
+    let corner = Vec3::new(lo, lo, 0.0);
+    let mut rim = Vec::new();
+    for k in 0..=30 {
+        rim.push(Vec3::new(hi, lo + (hi - lo) * k as f32 / 30.0, 0.0));
+    }
+    for k in 1..=30 {
+        rim.push(Vec3::new(hi - (hi - lo) * k as f32 / 30.0, hi, 0.0));
+    }
+    let fan: Vec<Triangle> = rim
+        .windows(2)
+        .map(|w| Triangle {
+            positions: [corner, w[0], w[1]],
+            normal: Vec3::new(0.0, 0.0, -1.0),
+        })
+        .collect();
+    let mut scene = Scene::new();
+    scene.add_piece(GREY, Step(1), fan);
+    let view = View {
+        azimuth_deg: 20.0,
+        elevation_deg: 25.0,
+        quarter_turns: 0,
+    };
+    let r = StepRenderer::new(scene, &opts().with_size(320, 320).with_view(view)).unwrap();
+    let img = r.model_image();
+    // Inside the face every pixel has the face's one colour.
+    let centre = *img.get_pixel(160, 160);
+    for y in 120..200 {
+        for x in 120..200 {
+            assert_eq!(*img.get_pixel(x, y), centre, "speck at ({x}, {y})");
+        }
+    }
+}
