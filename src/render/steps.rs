@@ -291,9 +291,9 @@ pub fn write_png(img: &RgbaImage, alpha: bool, w: &mut dyn Write) -> io::Result<
     let res = if alpha {
         enc.write_image(img.as_raw(), width, height, image::ExtendedColorType::Rgba8)
     } else {
-        let mut rgb = Vec::with_capacity(img.as_raw().len() / 4 * 3);
-        for p in img.as_raw().chunks_exact(4) {
-            rgb.extend_from_slice(&p[..3]);
+        let mut rgb = vec![0u8; img.as_raw().len() / 4 * 3];
+        for (d, s) in rgb.chunks_exact_mut(3).zip(img.as_raw().chunks_exact(4)) {
+            d.copy_from_slice(&s[..3]);
         }
         enc.write_image(&rgb, width, height, image::ExtendedColorType::Rgb8)
     };
