@@ -7,7 +7,8 @@
 //! ```
 //!
 //! Writes `OUT_DIR/model.png` and `OUT_DIR/steps/step-NNN.png`, and prints
-//! how many step images a second the renderer made.
+//! how many step images a second the renderer made: in memory on one
+//! thread, then written to disk (atomically, each file synced) in parallel.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -71,6 +72,22 @@ fn main() -> Result<()> {
     if !steps {
         return Ok(());
     }
+    // In memory on this thread: the renderer and encoder alone, no disk.
+    let t = Instant::now();
+    let mut bytes = 0;
+    for (_, img) in renderer.images() {
+        let mut png = Vec::new();
+        render::write_png(&img, false, &mut png)?;
+        bytes += png.len();
+    }
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!(
+        "in memory, one thread: {} step images in {:.3} s: {:.1} images/s, {:.0} KiB a PNG",
+        renderer.steps().len(),
+        secs,
+        renderer.steps().len() as f64 / secs.max(1e-9),
+        bytes as f64 / 1024.0 / renderer.steps().len().max(1) as f64
+    );
     let t = Instant::now();
     let paths = renderer.write_steps(&out.join("steps"))?;
     let secs = t.elapsed().as_secs_f64();
