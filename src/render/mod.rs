@@ -29,9 +29,39 @@
 //! (see [`StepImages`]); [`StepRenderer::write_steps`] renders runs of
 //! steps in parallel.
 //!
-//! # Example
+//! # Examples
 //!
-//! A red box added in step 1 and a grey one on top in step 2:
+//! From an [`Assembly`], the usual way in: pieces get their part meshes
+//! from [`crate::export::partmesh`], placed exactly as the `.ldr` places
+//! them.
+//!
+//! ```
+//! use brickwright::assembly::{Assembly, Placement};
+//! use brickwright::catalog::{Color, PartKind};
+//! use brickwright::geom::{Cell, Rot};
+//! use brickwright::render::{self, RenderOptions};
+//!
+//! let brick = PartKind::from_id("3001").unwrap();
+//! let order = [
+//!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+//!     Placement::new(brick, Cell::new(1, 0, 1), Rot::R90),
+//! ];
+//! let asm = Assembly::from_order(&order, 24, Color::RED);
+//! let opts = RenderOptions::default().with_size(200, 150);
+//!
+//! let model = render::model_image(&asm, &opts).unwrap();
+//! assert_eq!(model.dimensions(), (200, 150));
+//! let steps: Vec<_> = render::steps(&asm, &opts).unwrap().collect();
+//! assert_eq!(steps.len(), 2);
+//! let dir = tempfile::tempdir().unwrap();
+//! let files = render::write_steps(&asm, &opts, dir.path()).unwrap();
+//! assert!(files[1].ends_with("step-002.png"));
+//! let thumb = render::part_image(brick, Color::RED);
+//! assert_eq!(thumb.dimensions(), (128, 128));
+//! ```
+//!
+//! Any geometry, through a [`Scene`]: a red box added in step 1 and a grey
+//! one on top in step 2.
 //!
 //! ```
 //! use brickwright::assembly::Step;
@@ -88,6 +118,10 @@ use compose::Style;
 
 /// Largest image side, in pixels.
 pub const MAX_SIZE: u32 = 8192;
+
+/// Most samples (pixels times supersamples) an image may take: its
+/// buffers hold 12 bytes a sample.
+pub const MAX_SAMPLES: u64 = 64 << 20;
 
 /// Side in pixels of [`part_image`]'s square pictures.
 pub const PART_IMAGE_SIZE: u32 = 128;
@@ -293,6 +327,19 @@ impl RenderOptions {
         };
         if !(1..=4).contains(&self.supersample) {
             return bad("supersample", self.supersample.to_string(), "1 to 4");
+        }
+        let samples = u64::from(self.width)
+            * u64::from(self.height)
+            * u64::from(self.supersample * self.supersample);
+        if samples > MAX_SAMPLES {
+            return bad(
+                "size x supersample",
+                format!(
+                    "{} x {} pixels at {} x {} samples",
+                    self.width, self.height, self.supersample, self.supersample
+                ),
+                "at most 64 Mi samples (about 4096 x 4096 pixels at 2 x 2)",
+            );
         }
         if !(0.5..=8.0).contains(&self.line_width) {
             return bad("line width", self.line_width.to_string(), "0.5 to 8 pixels");

@@ -216,6 +216,7 @@ fn bad_options_are_refused_with_a_reason() {
         opts().with_size(0, 10),
         opts().with_size(10, 100_000),
         opts().with_supersample(0),
+        opts().with_size(8192, 8192).with_supersample(4),
         opts().with_line_width(f32::NAN),
         opts().with_fade(2.0),
         opts().with_margin(60),
