@@ -18,7 +18,10 @@
 //! - [`assembly`] is the ordered build every exporter reads, with an
 //!   independent verifier.
 //! - [`ldraw`] writes (and reads back) LDraw `.ldr` files.
-//! - [`export`] draws the build: part meshes, exploded views, glTF 2.0.
+//! - [`export`] writes the build for viewers and shops: part meshes,
+//!   exploded views, glTF 2.0, BrickLink and Rebrickable parts lists.
+//! - [`render`] draws instruction images: step pictures and part pictures.
+//! - [`booklet`] lays out the printable PDF instructions.
 //! - [`pipeline`] ties the stages together for the command-line tool.
 
 pub mod assembly;
@@ -31,5 +34,6 @@ pub mod grammar;
 pub mod ldraw;
 pub mod mesh;
 pub mod pipeline;
+pub mod render;
 pub mod search;
 pub mod voxel;

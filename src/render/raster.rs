@@ -1,0 +1,388 @@
+//! Triangle fill with a depth buffer, at the supersampled resolution.
+//!
+//! A plain edge-function rasterizer: for each triangle, every sample centre
+//! inside its screen bounding box is tested against the three edges
+//! (top-left fill rule, so two triangles sharing an edge never both or
+//! neither cover a sample), its depth interpolated, and it is kept when
+//! nearer than what the sample holds. What a sample keeps is not a colour
+//! but the facts the compositor needs: depth, which piece, and the face
+//! normal with its shade. Colours, fading and outlines come later, so the
+//! same buffer serves every look of a step.
+
+use glam::{Vec2, Vec3};
+
+use super::camera::Camera;
+use super::scene::Scene;
+
+/// A sample's piece when nothing covers it.
+pub(crate) const EMPTY: u32 = u32::MAX;
+
+/// An axis-aligned rectangle of pixels, `x0..x1` by `y0..y1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PixelRect {
+    /// Left column (inclusive).
+    pub x0: u32,
+    /// Top row (inclusive).
+    pub y0: u32,
+    /// Right column (exclusive).
+    pub x1: u32,
+    /// Bottom row (exclusive).
+    pub y1: u32,
+}
+
+impl PixelRect {
+    /// True when the rectangle holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// The smallest rectangle holding both (an empty one adds nothing).
+    pub fn union(self, o: PixelRect) -> PixelRect {
+        if self.is_empty() {
+            return o;
+        }
+        if o.is_empty() {
+            return self;
+        }
+        PixelRect {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+
+    /// Grown by `d` pixels on every side, clipped to `w` x `h`.
+    pub fn grown(self, d: u32, w: u32, h: u32) -> PixelRect {
+        if self.is_empty() {
+            return self;
+        }
+        PixelRect {
+            x0: self.x0.saturating_sub(d),
+            y0: self.y0.saturating_sub(d),
+            x1: (self.x1 + d).min(w),
+            y1: (self.y1 + d).min(h),
+        }
+    }
+
+    /// True when pixel `(x, y)` lies inside.
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
+    }
+
+    /// The empty rectangle.
+    pub const EMPTY: PixelRect = PixelRect {
+        x0: 0,
+        y0: 0,
+        x1: 0,
+        y1: 0,
+    };
+}
+
+/// How a face is lit: a light fixed to the camera, from above and from the
+/// viewer's left, so tops are light, the left-hand side mid and the
+/// right-hand side dark, whatever the view.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Light {
+    up: Vec3,
+    left: Vec3,
+    eye: Vec3,
+}
+
+impl Light {
+    pub(crate) fn for_camera(camera: &Camera) -> Light {
+        Light {
+            up: Vec3::new(0.0, -1.0, 0.0),
+            left: -camera.right(),
+            eye: camera.toward_eye(),
+        }
+    }
+
+    /// Brightness in 0..=255 of a face with unit normal `n`.
+    pub(crate) fn shade(&self, n: Vec3) -> u8 {
+        let s = 0.60 + 0.34 * n.dot(self.up) + 0.17 * n.dot(self.left) + 0.06 * n.dot(self.eye);
+        (s.clamp(0.25, 1.0) * 255.0).round() as u8
+    }
+}
+
+/// The supersampled buffers: per sample, depth, piece and face.
+#[derive(Debug, Clone)]
+pub(crate) struct Samples {
+    /// Width in samples.
+    pub w: usize,
+    /// Height in samples.
+    pub h: usize,
+    /// Samples per pixel along each axis.
+    pub ss: usize,
+    /// Distance from the viewer in LDU; `INFINITY` where empty.
+    pub depth: Vec<f32>,
+    /// Scene piece index, or [`EMPTY`].
+    pub piece: Vec<u32>,
+    /// Quantized face normal (x, y, z as `i8` bits) and shade.
+    pub face: Vec<[u8; 4]>,
+}
+
+impl Samples {
+    /// Empty buffers for a `width` x `height` pixel image with `ss` x `ss`
+    /// samples a pixel.
+    pub(crate) fn new(width: u32, height: u32, ss: u32) -> Samples {
+        let ss = ss.max(1) as usize;
+        let w = width as usize * ss;
+        let h = height as usize * ss;
+        Samples {
+            w,
+            h,
+            ss,
+            depth: vec![f32::INFINITY; w * h],
+            piece: vec![EMPTY; w * h],
+            face: vec![[0; 4]; w * h],
+        }
+    }
+
+    /// Draws piece `index` of `scene`, culling faces turned away from the
+    /// viewer.
+    pub(crate) fn draw_piece(
+        &mut self,
+        scene: &Scene,
+        index: usize,
+        camera: &Camera,
+        light: &Light,
+    ) {
+        let eye = camera.toward_eye();
+        let ss = self.ss as f32;
+        let per_sample = camera.scale() * ss;
+        for t in scene.piece_triangles(index) {
+            if t.normal.dot(eye) <= 1e-4 {
+                continue;
+            }
+            // Depth across the screen follows the triangle's plane, taken
+            // from its world corners: stable even for long slivers, where
+            // barycentric weights lose precision.
+            let [a, b, c] = t.positions;
+            let g = (b - a).cross(c - a);
+            let toward = g.dot(eye);
+            if toward.abs() <= 1e-6 * g.length() {
+                continue;
+            }
+            let slope =
+                Vec2::new(g.dot(camera.right()), g.dot(camera.down())) / (toward * per_sample);
+            let p = t.positions.map(|v| {
+                let q = camera.project(v);
+                Vec3::new(q.x * ss, q.y * ss, q.z)
+            });
+            let n = t.normal;
+            let q = |c: f32| (c.clamp(-1.0, 1.0) * 127.0).round() as i8 as u8;
+            let face = [q(n.x), q(n.y), q(n.z), light.shade(n)];
+            self.fill(p, slope, index as u32, face);
+        }
+    }
+
+    /// Fills one triangle given in sample coordinates (x, y) with depth z,
+    /// the depth growing by `slope` per sample along x and y.
+    fn fill(&mut self, p: [Vec3; 3], slope: Vec2, piece: u32, face: [u8; 4]) {
+        let [mut a, mut b, c] = p;
+        let (za, zx, zy) = (a.z - slope.x * a.x - slope.y * a.y, slope.x, slope.y);
+        let area = edge(a.truncate(), b.truncate(), c.truncate());
+        if !area.is_finite() || area.abs() < 1e-6 {
+            return;
+        }
+        // Make the winding positive on screen (y down): culling is done by
+        // the normal, so either winding is drawn.
+        if area < 0.0 {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let (a2, b2, c2) = (a.truncate(), b.truncate(), c.truncate());
+        let lo = a2.min(b2).min(c2);
+        let hi = a2.max(b2).max(c2);
+        let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
+        let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
+        let x1 = ((hi.x - 0.5).floor() + 1.0).clamp(0.0, self.w as f32) as usize;
+        let y1 = ((hi.y - 0.5).floor() + 1.0).clamp(0.0, self.h as f32) as usize;
+        if x0 >= x1 || y0 >= y1 {
+            return;
+        }
+        // Edge functions w_i(x, y) = A_i x + B_i y + C_i, positive inside.
+        // A sample exactly on an edge belongs to the triangle for which the
+        // edge is "top-left"; the neighbour across the edge evaluates the
+        // exact negation, so exactly one of the two takes it.
+        let setup = |u: Vec2, v: Vec2| {
+            let (ea, eb) = (u.y - v.y, v.x - u.x);
+            let ec = u.x * v.y - u.y * v.x;
+            let top_left = (ea == 0.0 && eb < 0.0) || ea > 0.0;
+            (ea, eb, ec, top_left)
+        };
+        let outside = |w: f32, top_left: bool| if top_left { w < 0.0 } else { w <= 0.0 };
+        let e0 = setup(b2, c2);
+        let e1 = setup(c2, a2);
+        let e2 = setup(a2, b2);
+        for y in y0..y1 {
+            let py = y as f32 + 0.5;
+            let row = y * self.w;
+            // Each edge value is evaluated exactly, in the same order for
+            // both triangles of a shared edge (so they see exact negations);
+            // a row's covered samples are contiguous, so leave the row once
+            // past them.
+            let (r0, r1, r2) = (e0.1 * py + e0.2, e1.1 * py + e1.2, e2.1 * py + e2.2);
+            // Narrow the row to where the edges cross it (with a sample of
+            // slack each side; the exact tests below decide), so long thin
+            // triangles cost their area, not their bounding box.
+            let (mut lo, mut hi) = (x0 as f32, x1 as f32);
+            for (e, r) in [(e0, r0), (e1, r1), (e2, r2)] {
+                let ea = e.0;
+                if ea == 0.0 {
+                    continue;
+                }
+                // Where the edge crosses the row, give or take the rounding
+                // of `r` divided by a possibly small slope (nearly
+                // horizontal edges), plus a sample.
+                let cross = -r / ea - 0.5;
+                let slack = 1.0 + (e.1.abs() * py + e.2.abs() + ea.abs() * hi) * 1e-6 / ea.abs();
+                if ea > 0.0 {
+                    lo = lo.max((cross - slack).floor());
+                } else {
+                    hi = hi.min((cross + slack).ceil() + 1.0);
+                }
+            }
+            if lo >= hi {
+                continue;
+            }
+            let (xa, xb) = (lo as usize, (hi as usize).min(x1));
+            let mut entered = false;
+            for x in xa..xb {
+                let px = x as f32 + 0.5;
+                let w0 = e0.0 * px + r0;
+                let w1 = e1.0 * px + r1;
+                let w2 = e2.0 * px + r2;
+                if outside(w0, e0.3) || outside(w1, e1.3) || outside(w2, e2.3) {
+                    if entered {
+                        break;
+                    }
+                    continue;
+                }
+                entered = true;
+                let z = za + zx * px + zy * py;
+                let i = row + x;
+                if z < self.depth[i] {
+                    self.depth[i] = z;
+                    self.piece[i] = piece;
+                    self.face[i] = face;
+                }
+            }
+        }
+    }
+}
+
+/// Twice the signed area of `a b c`, positive when clockwise on a y-down
+/// screen (counter-clockwise in the usual y-up picture).
+fn edge(a: Vec2, b: Vec2, c: Vec2) -> f32 {
+    (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)
+}
+
+/// The pixels a piece can touch: the screen bounding box of its corners,
+/// clipped to the image.
+pub(crate) fn piece_rect(scene: &Scene, index: usize, camera: &Camera) -> PixelRect {
+    let mut lo = Vec2::splat(f32::INFINITY);
+    let mut hi = Vec2::splat(f32::NEG_INFINITY);
+    for t in scene.piece_triangles(index) {
+        for &v in &t.positions {
+            let q = camera.project(v).truncate();
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return PixelRect::EMPTY;
+    }
+    let (w, h) = (camera.width() as f32, camera.height() as f32);
+    PixelRect {
+        x0: lo.x.floor().clamp(0.0, w) as u32,
+        y0: lo.y.floor().clamp(0.0, h) as u32,
+        x1: (hi.x.ceil() + 1.0).clamp(0.0, w) as u32,
+        y1: (hi.y.ceil() + 1.0).clamp(0.0, h) as u32,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Step;
+    use crate::render::camera::View;
+    use crate::render::scene::test_geometry::cuboid;
+    use image::Rgb;
+
+    fn two_boxes(near_first: bool) -> (Scene, usize, usize) {
+        let mut scene = Scene::new();
+        let near = || cuboid(Vec3::new(-10.0, -10.0, -30.0), Vec3::new(10.0, 10.0, -10.0));
+        let far = || cuboid(Vec3::new(-20.0, -20.0, 10.0), Vec3::new(20.0, 20.0, 30.0));
+        let (n, f);
+        if near_first {
+            n = scene.add_piece(Rgb([255, 0, 0]), Step(1), near());
+            f = scene.add_piece(Rgb([0, 0, 255]), Step(1), far());
+        } else {
+            f = scene.add_piece(Rgb([0, 0, 255]), Step(1), far());
+            n = scene.add_piece(Rgb([255, 0, 0]), Step(1), near());
+        }
+        (scene, n, f)
+    }
+
+    #[test]
+    fn the_near_box_hides_the_far_one_in_any_drawing_order() {
+        let front = View {
+            azimuth_deg: 0.0,
+            elevation_deg: 0.0,
+            quarter_turns: 0,
+        };
+        for near_first in [true, false] {
+            let (scene, near, far) = two_boxes(near_first);
+            let cam = Camera::fit(&front, scene.points(), 64, 64, 2);
+            let light = Light::for_camera(&cam);
+            let mut s = Samples::new(64, 64, 1);
+            for i in 0..2 {
+                s.draw_piece(&scene, i, &cam, &light);
+            }
+            // The centre shows the near box, a point off its side the far one.
+            assert_eq!(s.piece[32 * 64 + 32], near as u32);
+            assert_eq!(s.piece[32 * 64 + 6], far as u32);
+            assert_eq!(s.piece[0], EMPTY);
+        }
+    }
+
+    #[test]
+    fn shared_edges_leave_no_gaps_or_double_cover() {
+        // A quad as two triangles: no sample is covered twice, and the
+        // samples along the shared diagonal are all covered.
+        let q = [
+            Vec3::new(1.3, 2.1, 0.0),
+            Vec3::new(14.7, 1.9, 0.0),
+            Vec3::new(13.2, 14.6, 0.0),
+            Vec3::new(2.2, 13.9, 0.0),
+        ];
+        let mut t = Samples::new(16, 16, 1);
+        t.fill([q[0], q[1], q[2]], Vec2::ZERO, 0, [0; 4]);
+        let mut u = Samples::new(16, 16, 1);
+        u.fill([q[0], q[2], q[3]], Vec2::ZERO, 1, [0; 4]);
+        let mut both = Samples::new(16, 16, 1);
+        both.fill([q[0], q[1], q[2]], Vec2::ZERO, 0, [0; 4]);
+        both.fill([q[0], q[2], q[3]], Vec2::ZERO, 1, [0; 4]);
+        for i in 0..256 {
+            let (a, b) = (t.piece[i] != EMPTY, u.piece[i] != EMPTY);
+            assert!(!(a && b), "sample {i} covered twice");
+            assert_eq!(a || b, both.piece[i] != EMPTY);
+        }
+        for k in 3..13 {
+            // Samples next to the diagonal, well inside the quad.
+            assert_ne!(both.piece[k * 16 + k], EMPTY, "gap at ({k}, {k})");
+        }
+    }
+
+    #[test]
+    fn faces_turned_away_are_culled_and_sides_shade_apart() {
+        let cam = Camera::new(&View::default(), Vec3::ZERO, 1.0, 10, 10);
+        let light = Light::for_camera(&cam);
+        let top = light.shade(Vec3::new(0.0, -1.0, 0.0));
+        let front = light.shade(Vec3::new(0.0, 0.0, -1.0));
+        let right = light.shade(Vec3::new(1.0, 0.0, 0.0));
+        assert!(top > front && front > right, "{top} {front} {right}");
+        assert!(front - right > 40);
+    }
+}
