@@ -75,7 +75,9 @@ where
         fill(&mut w)?;
         w.flush()?;
     }
-    tmp.as_file().sync_all()?;
+    // No fsync: the rename makes the file appear whole or not at all if
+    // the process fails; syncing every file (hundreds of step images)
+    // would cost more than the whole render.
     // Temporary files are private (0600); outputs are ordinary files.
     #[cfg(unix)]
     {

@@ -179,10 +179,14 @@ struct BuildArgs {
     /// The condition the BrickLink wanted list asks for: N (new) or U (used); default any.
     #[arg(long, value_enum)]
     condition: Option<ConditionArg>,
-    /// The files to write, comma-separated: ldr, glb, exploded-glb, gltf, bricklink, csv, or
-    /// all (every one but gltf); report.json is always written.
+    /// The files to write, comma-separated: ldr, glb, exploded-glb, gltf, bricklink, csv,
+    /// steps, png, exploded-png, pdf, or all (every one but gltf); report.json is always written.
     #[arg(long, default_value = "all", value_parser = parse_formats)]
     formats: pipeline::Formats,
+    /// The booklet's layout (page size, margins, steps a page, fonts, colours): a TOML file
+    /// like templates/default.toml; default the built-in one.
+    #[arg(long, value_name = "FILE")]
+    template: Option<PathBuf>,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -244,6 +248,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
         ConditionArg::Used => brickwright::export::partslist::Condition::Used,
     });
     opts.formats = a.formats;
+    opts.template = a.template;
     opts.search = opts
         .search
         .with_seed(a.seed)
@@ -290,8 +295,20 @@ fn run_build(a: BuildArgs) -> Result<()> {
                 r.unmapped_colors
             );
         }
-        for f in &r.outputs {
+        let is_step = |f: &str| {
+            std::path::Path::new(f)
+                .parent()
+                .is_some_and(|d| d.ends_with("steps"))
+        };
+        let steps: Vec<&String> = r.outputs.iter().filter(|f| is_step(f)).collect();
+        for f in r.outputs.iter().filter(|f| !is_step(f)) {
             outln!("  wrote {f}");
+        }
+        if let Some(first) = steps.first() {
+            let dir = std::path::Path::new(first.as_str())
+                .parent()
+                .unwrap_or(std::path::Path::new("."));
+            outln!("  wrote {} step images in {}", steps.len(), dir.display());
         }
         let rep = &r.repairs;
         if rep.budget_left_out > 0 {
@@ -314,8 +331,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
         );
         let s = &r.seconds;
         outln!(
-            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, write {:.2}s",
-            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.write
+            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, render {:.2}s, booklet {:.2}s, write {:.2}s",
+            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.render, s.booklet, s.write
         );
     }
     Ok(())

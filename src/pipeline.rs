@@ -8,11 +8,15 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod images;
+
 use serde::Serialize;
 use thiserror::Error;
 
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, StepGrouping};
+use crate::booklet::template::TemplateError;
+use crate::booklet::Template;
 use crate::catalog::{Color, Family, Palette};
 use crate::export::gltf::{write_gltf, Container, GltfOptions};
 use crate::export::partslist::{
@@ -57,6 +61,9 @@ pub struct BuildOptions {
     /// The files to write besides `report.json`. Default
     /// [`Formats::default`]: every format but `.gltf`.
     pub formats: Formats,
+    /// The booklet's layout template; `None` for the built-in
+    /// `templates/default.toml`.
+    pub template: Option<PathBuf>,
 }
 
 /// A file `brickwright build` can write.
@@ -76,17 +83,29 @@ pub enum Format {
     Bricklink,
     /// `<stem>-parts.csv`: a Rebrickable parts list.
     Csv,
+    /// `steps/step-001.png`...: an image of every step.
+    Steps,
+    /// `<stem>.png`: the finished model.
+    Png,
+    /// `<stem>-exploded.png`: the exploded view, the finished model beside it.
+    ExplodedPng,
+    /// `<stem>.pdf`: the printable instruction booklet.
+    Pdf,
 }
 
 impl Format {
     /// Every format, in the order files are written.
-    pub const ALL: [Format; 6] = [
+    pub const ALL: [Format; 10] = [
         Format::Ldr,
         Format::Glb,
         Format::ExplodedGlb,
         Format::Gltf,
         Format::Bricklink,
         Format::Csv,
+        Format::Steps,
+        Format::Png,
+        Format::ExplodedPng,
+        Format::Pdf,
     ];
 
     /// Whether `--formats all` (and the default) includes it: every format
@@ -104,6 +123,10 @@ impl Format {
             Format::Gltf => "gltf",
             Format::Bricklink => "bricklink",
             Format::Csv => "csv",
+            Format::Steps => "steps",
+            Format::Png => "png",
+            Format::ExplodedPng => "exploded-png",
+            Format::Pdf => "pdf",
         }
     }
 
@@ -116,6 +139,10 @@ impl Format {
             Format::Gltf => format!("{stem}.gltf"),
             Format::Bricklink => format!("{stem}-bricklink.xml"),
             Format::Csv => format!("{stem}-parts.csv"),
+            Format::Steps => "steps".into(),
+            Format::Png => format!("{stem}.png"),
+            Format::ExplodedPng => format!("{stem}-exploded.png"),
+            Format::Pdf => format!("{stem}.pdf"),
         }
     }
 }
@@ -189,6 +216,7 @@ impl BuildOptions {
             palette: Palette::default(),
             condition: None,
             formats: Formats::default(),
+            template: None,
         }
     }
 }
@@ -210,6 +238,12 @@ pub enum BuildError {
     /// The rule file is bad.
     #[error(transparent)]
     Rules(#[from] RuleError),
+    /// The booklet template is bad.
+    #[error(transparent)]
+    Template(#[from] TemplateError),
+    /// The images could not be drawn.
+    #[error("rendering: {0}")]
+    Render(#[from] crate::render::RenderError),
     /// The search found no build.
     #[error("{file}: {reason}")]
     Search {
@@ -249,6 +283,10 @@ pub struct StageTimes {
     pub search: f64,
     /// Independent verification.
     pub verify: f64,
+    /// Rendering the images (steps, model, exploded view, part pictures).
+    pub render: f64,
+    /// Laying out the booklet.
+    pub booklet: f64,
     /// Writing outputs.
     pub write: f64,
 }
@@ -288,6 +326,8 @@ pub struct BuildReport {
     pub components: usize,
     /// Steps in the outputs.
     pub steps: u32,
+    /// Pages of the booklet, when one was written.
+    pub booklet_pages: Option<usize>,
     /// The build order: `by course` (the search's pieces re-sequenced
     /// course by course, verified) or `search trace` (when the
     /// re-sequenced order did not verify).
@@ -381,6 +421,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         Family::Plate => opts.plates,
         Family::Slope => opts.slopes,
     })?;
+    let template = match &opts.template {
+        Some(path) => Template::load(path)?,
+        None => Template::default(),
+    };
     times.rules = secs(t);
 
     progress.stage("loading mesh");
@@ -437,17 +481,64 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     times.verify = secs(t);
     progress.done();
 
+    let stem = opts
+        .input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".into());
+    let (nx, ny, nz) = outcome.voxels.dims();
+    let size_cm = [
+        nx as f64 * 0.8,
+        ny as f64 * 0.8,
+        (f64::from(nz * rules.layer_ldu()) * 0.04 * 100.0).round() / 100.0,
+    ];
+    let formats = &opts.formats;
+    let wants_steps = formats.contains(Format::Steps) || formats.contains(Format::Pdf);
+    let rendered =
+        if wants_steps || formats.contains(Format::Png) || formats.contains(Format::ExplodedPng) {
+            progress.stage("rendering");
+            let t = Instant::now();
+            let pictures = images::Pictures {
+                assembly: &assembly,
+                title: &stem,
+                size_studs: [
+                    f64::from(nx),
+                    f64::from(ny),
+                    f64::from(nz * rules.layer_ldu()) / 24.0,
+                ],
+                size_cm,
+            };
+            let rendered = images::render_all(&pictures, wants_steps)?;
+            times.render = secs(t);
+            let booklet = if formats.contains(Format::Pdf) {
+                let t = Instant::now();
+                let pdf = images::booklet(&pictures, &rendered, &template).map_err(|reason| {
+                    BuildError::Write {
+                        path: opts
+                            .out_dir
+                            .join(Format::Pdf.file_name(&stem))
+                            .display()
+                            .to_string(),
+                        reason,
+                    }
+                })?;
+                times.booklet = secs(t);
+                Some(pdf)
+            } else {
+                None
+            };
+            progress.done();
+            Some((rendered, booklet))
+        } else {
+            None
+        };
+
     progress.stage("writing");
     let t = Instant::now();
     std::fs::create_dir_all(&opts.out_dir).map_err(|reason| BuildError::Write {
         path: opts.out_dir.display().to_string(),
         reason,
     })?;
-    let stem = opts
-        .input
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "model".into());
     let report_path = opts.out_dir.join("report.json");
     let meta = LdrMeta {
         title: format!("{stem}, built by brickwright"),
@@ -466,7 +557,6 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             format!("seed: {}", opts.search.seed),
         ],
     };
-    let (nx, ny, nz) = outcome.voxels.dims();
     let parts = PartsList::of(&assembly);
     let pieces = assembly.pieces.len();
     let voxels = outcome.voxels.count();
@@ -511,12 +601,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: 1,
         steps: assembly.step_count(),
+        booklet_pages: formats
+            .contains(Format::Pdf)
+            .then(|| crate::booklet::page_count(&assembly, &template)),
         order: order_name.into(),
-        size_cm: [
-            nx as f64 * 0.8,
-            ny as f64 * 0.8,
-            (nz as f64 * 0.96 * 100.0).round() / 100.0,
-        ],
+        size_cm,
         seconds: times,
         search: outcome.stats.clone(),
         repairs: outcome.repairs.clone(),
@@ -542,6 +631,41 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             }
             Format::Bricklink => files.add(&path, |w| write_bricklink(w, &parts, opts.condition)),
             Format::Csv => files.add(&path, |w| write_rebrickable_csv(w, &parts)),
+            Format::Steps | Format::Png | Format::ExplodedPng | Format::Pdf => {
+                let Some((rendered, booklet)) = &rendered else {
+                    unreachable!("pictures are rendered when a pictured format is asked for")
+                };
+                match format {
+                    Format::Steps => {
+                        std::fs::create_dir_all(&path).map_err(|reason| BuildError::Write {
+                            path: path.display().to_string(),
+                            reason,
+                        })?;
+                        let pngs = images::encode_all(&rendered.steps);
+                        let paths = images::step_paths(&path, pngs.len());
+                        let mut written = Ok(());
+                        for (png, p) in pngs.iter().zip(&paths) {
+                            written = files.add(p, |w| w.write_all(png));
+                            if written.is_err() {
+                                break;
+                            }
+                        }
+                        written
+                    }
+                    Format::Png => {
+                        let png = images::encode(&rendered.model);
+                        files.add(&path, |w| w.write_all(&png))
+                    }
+                    Format::ExplodedPng => {
+                        let png = images::encode(&rendered.exploded);
+                        files.add(&path, |w| w.write_all(&png))
+                    }
+                    _ => {
+                        let pdf = booklet.as_deref().unwrap_or_default();
+                        files.add(&path, |w| w.write_all(pdf))
+                    }
+                }
+            }
         };
         written.map_err(|reason| BuildError::Write {
             path: path.display().to_string(),
@@ -567,6 +691,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         path: path.display().to_string(),
         reason,
     })?;
+    if let Some((rendered, _)) = &rendered {
+        if formats.contains(Format::Steps) {
+            images::remove_stale_steps(&opts.out_dir.join("steps"), rendered.steps.len());
+        }
+    }
     progress.done();
     Ok(BuildOutput { assembly, report })
 }

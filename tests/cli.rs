@@ -145,18 +145,23 @@ fn build_and_verify(name: &str) {
     let ldr = out.join(format!("{stem}.ldr"));
     assert!(ldr.is_file(), "{} was not written", ldr.display());
     let report = read_report(&out);
+    let steps = report_u64(&report, "steps") as usize;
     let mut expected: Vec<PathBuf> = [
         "ldr",
         ".glb",
         "-exploded.glb",
         "-bricklink.xml",
         "-parts.csv",
+        ".png",
+        "-exploded.png",
+        ".pdf",
     ]
     .iter()
     .map(|suffix| match *suffix {
         "ldr" => ldr.clone(),
         _ => out.join(format!("{stem}{suffix}")),
     })
+    .chain((1..=steps).map(|k| out.join("steps").join(format!("step-{k:03}.png"))))
     .chain([out.join("report.json")])
     .collect();
     expected.sort();

@@ -337,14 +337,19 @@ struct Placed {
 }
 
 /// Adds `img` to the document's resources under a name made from `n`
-/// (stable names keep the output the same run to run).
+/// (stable names keep the output the same run to run), flattened onto
+/// white.
 fn add_image(doc: &mut PdfDocument, n: &mut usize, img: &RgbaImage) -> Placed {
-    // Flatten onto white: printed pages have no alpha.
+    add_image_on(doc, n, img, Rgb([255, 255, 255]))
+}
+
+/// [`add_image`], flattened onto `bg`: printed pages have no alpha.
+fn add_image_on(doc: &mut PdfDocument, n: &mut usize, img: &RgbaImage, bg: Rgb) -> Placed {
     let mut rgb = Vec::with_capacity(img.width() as usize * img.height() as usize * 3);
     for p in img.pixels() {
         let a = u32::from(p.0[3]);
-        for c in &p.0[..3] {
-            rgb.push(((u32::from(*c) * a + 255 * (255 - a) + 127) / 255) as u8);
+        for (c, b) in p.0[..3].iter().zip(bg.0) {
+            rgb.push(((u32::from(*c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8);
         }
     }
     let id = XObjectId(format!("Im{n}"));
@@ -379,11 +384,9 @@ pub fn write_booklet<W: Write + ?Sized>(
 
 /// The pages the booklet will have: cover, parts list pages, step pages,
 /// exploded view.
-pub fn page_count(input: &BookletInput<'_>, template: &Template) -> usize {
-    let lines: Vec<usize> = step_parts(input.assembly).iter().map(Vec::len).collect();
-    1 + bom_pages(bom_lines(input.assembly).len(), template)
-        + plan_steps(&lines, template).len()
-        + 1
+pub fn page_count(assembly: &Assembly, template: &Template) -> usize {
+    let lines: Vec<usize> = step_parts(assembly).iter().map(Vec::len).collect();
+    1 + bom_pages(bom_lines(assembly).len(), template) + plan_steps(&lines, template).len() + 1
 }
 
 fn bom_lines(assembly: &Assembly) -> Vec<(PartKind, Color, usize)> {
@@ -476,10 +479,13 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     }
     finish(page, &mut pages, false);
 
-    // Parts pictures, each added once.
+    // Parts pictures, each added once on white (parts list) and once on
+    // the callout colour (step pages).
     let mut pictures: BTreeMap<(PartKind, Color), Placed> = BTreeMap::new();
+    let mut callout_pictures: BTreeMap<(PartKind, Color), Placed> = BTreeMap::new();
     for (key, img) in input.parts {
         pictures.insert(*key, add_image(&mut doc, &mut n, img));
+        callout_pictures.insert(*key, add_image_on(&mut doc, &mut n, img, t.colors.callout));
     }
 
     // Bill of materials.
@@ -572,7 +578,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
             for (j, &(part, color, count)) in items.iter().enumerate() {
                 let ix = cx + CALLOUT_PAD + (j % per_row) as f32 * CALLOUT_ITEM_W;
                 let iy = y + CALLOUT_PAD + (j / per_row) as f32 * item_h;
-                if let Some(pic) = pictures.get(&(part, color)) {
+                if let Some(pic) = callout_pictures.get(&(part, color)) {
                     page.image(pic, ix, iy, CALLOUT_ITEM_W - 2.0, CALLOUT_PICTURE);
                 }
                 let label = format!("{count}x");
@@ -672,7 +678,7 @@ mod tests {
         };
         let mut pdf = Vec::new();
         write_booklet(&mut pdf, &input, template).unwrap();
-        (pdf, page_count(&input, template))
+        (pdf, page_count(&a, template))
     }
 
     #[test]
