@@ -305,15 +305,24 @@ fn every_fixture_has_a_build_test() {
 
 /// Copies what a build wrote out of `out`, so the next build can write the
 /// same paths (report.json records them).
-fn take(out: &Path, stem: &str) -> (Vec<u8>, Value) {
-    let ldr = std::fs::read(out.join(format!("{stem}.ldr"))).unwrap();
+/// Every output but report.json, by path under `out`, and the report
+/// without its timings; `out` is removed.
+fn take(out: &Path) -> (Vec<(PathBuf, Vec<u8>)>, Value) {
+    let files = files_under(out)
+        .into_iter()
+        .filter(|p| !p.ends_with("report.json"))
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p.strip_prefix(out).unwrap().to_path_buf(), bytes)
+        })
+        .collect();
     let mut report = read_report(out);
     report
         .as_object_mut()
         .expect("report.json is an object")
         .remove("seconds");
     std::fs::remove_dir_all(out).unwrap();
-    (ldr, report)
+    (files, report)
 }
 
 #[test]
@@ -324,13 +333,19 @@ fn same_input_and_seed_give_the_same_build() {
         let input = fixture(name);
         let seed = ["--seed", "7"];
         build(tmp.path(), &input, &out, &seed).assert_ok();
-        let (ldr1, report1) = take(&out, stem);
+        let (files1, report1) = take(&out);
         build(tmp.path(), &input, &out, &seed).assert_ok();
-        let (ldr2, report2) = take(&out, stem);
-        assert!(
-            ldr1 == ldr2,
-            "{name}: two builds with seed 7 wrote different .ldr files"
-        );
+        let (files2, report2) = take(&out);
+        assert!(files1.len() > 10, "{name}: {} files", files1.len());
+        assert_eq!(files1.len(), files2.len());
+        for ((p1, b1), (p2, b2)) in files1.iter().zip(&files2) {
+            assert_eq!(p1, p2);
+            assert!(
+                b1 == b2,
+                "{name}: two builds with seed 7 wrote different {}",
+                p1.display()
+            );
+        }
         assert_eq!(report1, report2, "{name}: reports differ beyond `seconds`");
 
         build(tmp.path(), &input, &out, &["--seed", "8"]).assert_ok();
