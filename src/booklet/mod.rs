@@ -25,12 +25,15 @@ pub mod template;
 use std::collections::BTreeMap;
 use std::io::{self, Write};
 
+use flate2::write::ZlibEncoder;
+use flate2::Compression;
 use image::RgbaImage;
 use printpdf::{
-    BuiltinFont, Color as PdfColor, Line, LinePoint, Mm, Op, PaintMode, ParsedFont, PdfDocument,
-    PdfFontHandle, PdfPage, PdfSaveOptions, Point, Pt, RawImage, RawImageData, RawImageFormat,
+    BuiltinFont, Color as PdfColor, DictItem, ExternalStream, ExternalXObject, Line, LinePoint, Mm,
+    Op, PaintMode, ParsedFont, PdfDocument, PdfFontHandle, PdfPage, PdfSaveOptions, Point, Pt, Px,
     Rect, Rgb as PdfRgb, TextItem, XObject, XObjectId, XObjectTransform,
 };
+use rayon::prelude::*;
 
 use crate::assembly::Assembly;
 use crate::catalog::{Color, PartKind};
@@ -336,39 +339,84 @@ struct Placed {
     height: usize,
 }
 
-/// Adds `img` to the document's resources under a name made from `n`
-/// (stable names keep the output the same run to run), flattened onto
-/// white.
-fn add_image(doc: &mut PdfDocument, n: &mut usize, img: &RgbaImage) -> Placed {
-    add_image_on(doc, n, img, Rgb([255, 255, 255]))
+/// The images of a booklet, named as they are added and compressed all
+/// at once, in parallel, when the layout is done.
+struct Images<'a> {
+    jobs: Vec<(&'a RgbaImage, Rgb)>,
 }
 
-/// [`add_image`], flattened onto `bg`: printed pages have no alpha.
-fn add_image_on(doc: &mut PdfDocument, n: &mut usize, img: &RgbaImage, bg: Rgb) -> Placed {
-    let mut rgb = Vec::with_capacity(img.width() as usize * img.height() as usize * 3);
-    for p in img.pixels() {
-        let a = u32::from(p.0[3]);
-        for (c, b) in p.0[..3].iter().zip(bg.0) {
-            rgb.push(((u32::from(*c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8);
+impl<'a> Images<'a> {
+    /// Adds `img` flattened onto white; returns its name (stable names,
+    /// `Im0`, `Im1`..., keep the output the same run to run) and size.
+    fn add(&mut self, img: &'a RgbaImage) -> Placed {
+        self.add_on(img, Rgb([255, 255, 255]))
+    }
+
+    /// Adds `img` flattened onto `bg`: printed pages have no alpha.
+    fn add_on(&mut self, img: &'a RgbaImage, bg: Rgb) -> Placed {
+        let id = XObjectId(format!("Im{}", self.jobs.len()));
+        self.jobs.push((img, bg));
+        Placed {
+            id,
+            width: img.width() as usize,
+            height: img.height() as usize,
         }
     }
-    let id = XObjectId(format!("Im{n}"));
-    *n += 1;
-    let raw = RawImage {
-        pixels: RawImageData::U8(rgb),
-        width: img.width() as usize,
-        height: img.height() as usize,
-        data_format: RawImageFormat::RGB8,
-        tag: Vec::new(),
-    };
-    doc.resources
-        .xobjects
-        .map
-        .insert(id.clone(), XObject::Image(raw));
-    Placed {
-        id,
-        width: img.width() as usize,
-        height: img.height() as usize,
+
+    /// Flattens and deflates every image in parallel and adds them to the
+    /// document as image XObjects.
+    fn finish(self, doc: &mut PdfDocument) {
+        let streams: Vec<Vec<u8>> = self
+            .jobs
+            .par_iter()
+            .map(|&(img, bg)| {
+                // Flattened onto the background, RGB rows.
+                let mut data = Vec::with_capacity(img.width() as usize * img.height() as usize * 3);
+                for p in img.pixels() {
+                    let a = u32::from(p.0[3]);
+                    for (c, b) in p.0[..3].iter().zip(bg.0) {
+                        let (c, b) = (u32::from(*c), u32::from(b));
+                        data.push(((c * a + b * (255 - a) + 127) / 255) as u8);
+                    }
+                }
+                let mut z = ZlibEncoder::new(Vec::new(), Compression::new(3));
+                z.write_all(&data)
+                    .expect("deflating into memory does not fail");
+                z.finish().expect("deflating into memory does not fail")
+            })
+            .collect();
+        for (i, ((img, _), content)) in self.jobs.iter().zip(streams).enumerate() {
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            let dict = BTreeMap::from([
+                ("Type".to_string(), DictItem::Name(b"XObject".to_vec())),
+                ("Subtype".to_string(), DictItem::Name(b"Image".to_vec())),
+                ("Width".to_string(), DictItem::Int(w as i64)),
+                ("Height".to_string(), DictItem::Int(h as i64)),
+                (
+                    "ColorSpace".to_string(),
+                    DictItem::Name(b"DeviceRGB".to_vec()),
+                ),
+                ("BitsPerComponent".to_string(), DictItem::Int(8)),
+                (
+                    "Filter".to_string(),
+                    DictItem::Name(b"FlateDecode".to_vec()),
+                ),
+            ]);
+            let xobject = ExternalXObject {
+                stream: ExternalStream {
+                    dict,
+                    content,
+                    compress: false,
+                },
+                width: Some(Px(w)),
+                height: Some(Px(h)),
+                dpi: None,
+            };
+            doc.resources
+                .xobjects
+                .map
+                .insert(XObjectId(format!("Im{i}")), XObject::External(xobject));
+        }
     }
 }
 
@@ -431,7 +479,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     let mut doc = PdfDocument::new(input.title);
     doc.metadata.info.creator = format!("brickwright {}", env!("CARGO_PKG_VERSION"));
     doc.metadata.info.producer = doc.metadata.info.creator.clone();
-    let mut n = 0usize;
+    let mut images = Images { jobs: Vec::new() };
     let mut pages: Vec<PdfPage> = Vec::new();
     let mut number = 1usize;
     let mut finish = |mut page: PageOps, pages: &mut Vec<PdfPage>, numbered: bool| {
@@ -455,7 +503,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         (title_size, true, t.colors.accent),
         input.title,
     );
-    let model = add_image(&mut doc, &mut n, input.model);
+    let model = images.add(input.model);
     let top = m + title_size * 0.3528 + 8.0;
     page.image(&model, m, top, cw, ch - (top - m) - 30.0);
     let pieces = input.assembly.pieces.len();
@@ -484,8 +532,8 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     let mut pictures: BTreeMap<(PartKind, Color), Placed> = BTreeMap::new();
     let mut callout_pictures: BTreeMap<(PartKind, Color), Placed> = BTreeMap::new();
     for (key, img) in input.parts {
-        pictures.insert(*key, add_image(&mut doc, &mut n, img));
-        callout_pictures.insert(*key, add_image_on(&mut doc, &mut n, img, t.colors.callout));
+        pictures.insert(*key, images.add(img));
+        callout_pictures.insert(*key, images.add_on(img, t.colors.callout));
     }
 
     // Bill of materials.
@@ -591,7 +639,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                 );
             }
             let top = y + box_h.max(ns * 0.3528) + 3.0;
-            let img = add_image(&mut doc, &mut n, &input.steps[step as usize - 1]);
+            let img = images.add(&input.steps[step as usize - 1]);
             page.image_at(&img, x + 1.0, top, sw - 2.0, y + sh - top - 2.0, true);
         }
         finish(page, &mut pages, true);
@@ -607,11 +655,12 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
         (hs, true, t.colors.accent),
         "Exploded view",
     );
-    let ex = add_image(&mut doc, &mut n, input.exploded);
+    let ex = images.add(input.exploded);
     let top = m + hs * 0.3528 + 6.0;
     page.image(&ex, m, top, cw, ch - (top - m) - 4.0);
     finish(page, &mut pages, true);
 
+    images.finish(&mut doc);
     let mut warnings = Vec::new();
     let mut pdf = doc
         .with_pages(pages)
