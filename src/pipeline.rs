@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-mod images;
+pub mod pictures;
 
 use serde::Serialize;
 use thiserror::Error;
@@ -498,7 +498,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         if wants_steps || formats.contains(Format::Png) || formats.contains(Format::ExplodedPng) {
             progress.stage("rendering");
             let t = Instant::now();
-            let pictures = images::Pictures {
+            let pictures = pictures::Pictures {
                 assembly: &assembly,
                 title: &stem,
                 size_studs: [
@@ -508,11 +508,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 ],
                 size_cm,
             };
-            let rendered = images::render_all(&pictures, wants_steps)?;
+            let rendered = pictures::render_all(&pictures, wants_steps)?;
             times.render = secs(t);
             let booklet = if formats.contains(Format::Pdf) {
                 let t = Instant::now();
-                let pdf = images::booklet(&pictures, &rendered, &template).map_err(|reason| {
+                let pdf = pictures::booklet(&pictures, &rendered, &template).map_err(|reason| {
                     BuildError::Write {
                         path: opts
                             .out_dir
@@ -641,8 +641,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                             path: path.display().to_string(),
                             reason,
                         })?;
-                        let pngs = images::encode_all(&rendered.steps);
-                        let paths = images::step_paths(&path, pngs.len());
+                        let pngs = pictures::encode_all(&rendered.steps);
+                        let paths = pictures::step_paths(&path, pngs.len());
                         let mut written = Ok(());
                         for (png, p) in pngs.iter().zip(&paths) {
                             written = files.add(p, |w| w.write_all(png));
@@ -653,11 +653,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                         written
                     }
                     Format::Png => {
-                        let png = images::encode(&rendered.model);
+                        let png = pictures::encode(&rendered.model);
                         files.add(&path, |w| w.write_all(&png))
                     }
                     Format::ExplodedPng => {
-                        let png = images::encode(&rendered.exploded);
+                        let png = pictures::encode(&rendered.exploded);
                         files.add(&path, |w| w.write_all(&png))
                     }
                     _ => {
@@ -693,7 +693,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     })?;
     if let Some((rendered, _)) = &rendered {
         if formats.contains(Format::Steps) {
-            images::remove_stale_steps(&opts.out_dir.join("steps"), rendered.steps.len());
+            pictures::remove_stale_steps(&opts.out_dir.join("steps"), rendered.steps.len());
         }
     }
     progress.done();

@@ -2,7 +2,9 @@
 //! exploded view, and the PDF booklet that lays them out.
 //!
 //! Everything is rendered once, in parallel: the step images serve both
-//! `steps/step-NNN.png` and the booklet's step pages.
+//! `steps/step-NNN.png` and the booklet's step pages. The pipeline calls
+//! these; they are public for benchmarks and for library users who want
+//! the pictures of an assembly without a build.
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -19,15 +21,19 @@ use crate::export::partmesh::piece_transform;
 use crate::render::{self, write_png, Background, RenderError, RenderOptions, Scene, StepRenderer};
 
 /// What the pictured outputs need to know of the build.
-pub(crate) struct Pictures<'a> {
+pub struct Pictures<'a> {
+    /// The build, steps grouped.
     pub assembly: &'a Assembly,
+    /// The model's name, for the cover.
     pub title: &'a str,
+    /// Size in studs (x, y) and height in bricks.
     pub size_studs: [f64; 3],
+    /// Size in centimetres.
     pub size_cm: [f64; 3],
 }
 
 /// Rendered images, ready to be written.
-pub(crate) struct Rendered {
+pub struct Rendered {
     /// One image a step, step 1 first (empty unless asked for).
     pub steps: Vec<RgbaImage>,
     /// The finished model.
@@ -42,7 +48,7 @@ fn options() -> RenderOptions {
 }
 
 /// Renders what the outputs need: step images only when `steps`.
-pub(crate) fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError> {
+pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
     let step_images = if steps {
@@ -104,7 +110,7 @@ fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, Re
 }
 
 /// PNG bytes of every image, encoded in parallel.
-pub(crate) fn encode_all(images: &[RgbaImage]) -> Vec<Vec<u8>> {
+pub fn encode_all(images: &[RgbaImage]) -> Vec<Vec<u8>> {
     images
         .par_iter()
         .map(|img| {
@@ -116,14 +122,14 @@ pub(crate) fn encode_all(images: &[RgbaImage]) -> Vec<Vec<u8>> {
 }
 
 /// PNG bytes of one image.
-pub(crate) fn encode(img: &RgbaImage) -> Vec<u8> {
+pub fn encode(img: &RgbaImage) -> Vec<u8> {
     let mut buf = Vec::new();
     write_png(img, false, &mut buf).expect("encoding into memory does not fail");
     buf
 }
 
 /// The step image files, `DIR/steps/step-001.png`..., at least three digits.
-pub(crate) fn step_paths(dir: &Path, steps: usize) -> Vec<PathBuf> {
+pub fn step_paths(dir: &Path, steps: usize) -> Vec<PathBuf> {
     let digits = steps.to_string().len().max(3);
     (1..=steps)
         .map(|s| dir.join(format!("step-{s:0digits$}.png")))
@@ -133,7 +139,7 @@ pub(crate) fn step_paths(dir: &Path, steps: usize) -> Vec<PathBuf> {
 /// Removes `step-NNN.png` files of an earlier, longer run from `dir`, so
 /// the directory holds exactly this build's steps. Best effort: a file
 /// that cannot be removed stays.
-pub(crate) fn remove_stale_steps(dir: &Path, steps: usize) {
+pub fn remove_stale_steps(dir: &Path, steps: usize) {
     let keep: std::collections::BTreeSet<PathBuf> = step_paths(dir, steps).into_iter().collect();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
@@ -169,11 +175,7 @@ fn part_images(assembly: &Assembly) -> Result<BTreeMap<(PartKind, Color), RgbaIm
 }
 
 /// The booklet PDF's bytes.
-pub(crate) fn booklet(
-    p: &Pictures<'_>,
-    r: &Rendered,
-    template: &Template,
-) -> std::io::Result<Vec<u8>> {
+pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::Result<Vec<u8>> {
     let parts = part_images(p.assembly).map_err(std::io::Error::other)?;
     let input = BookletInput {
         title: p.title,

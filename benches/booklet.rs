@@ -1,0 +1,69 @@
+//! The booklet's speed: rendering every step image, the model, the
+//! exploded view and the part pictures, then laying out the PDF, for
+//! models of about 1,000 and 5,000 pieces.
+//!
+//! Targets (2 cores): the full booklet of a 1,000-piece model in under
+//! 5 s, of a 5,000-piece model in under 30 s. The models are solid blocks
+//! of 2 x 4 bricks, each course turned a quarter from the one below, built
+//! course by course and grouped into steps as `build` groups them; the
+//! search is not part of this benchmark (`benches/pipeline.rs` has it).
+//!
+//! ```text
+//! cargo bench --bench booklet
+//! cargo bench --bench booklet -- --warm-up-time 1 --measurement-time 5
+//! ```
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+
+use brickwright::assembly::{Assembly, Placement, StepGrouping};
+use brickwright::booklet::Template;
+use brickwright::catalog::{Palette, PartKind};
+use brickwright::geom::{Cell, Rot};
+use brickwright::pipeline::pictures::{booklet, render_all, Pictures};
+
+/// A `side` x `side` stud block of 2 x 4 bricks, `courses` high.
+fn block(side: i32, courses: i32) -> Assembly {
+    let brick = PartKind::from_id("3001").expect("3001 is in the catalog");
+    let mut order = Vec::new();
+    for z in 0..courses {
+        let rot = if z % 2 == 0 { Rot::R0 } else { Rot::R90 };
+        let (sx, sy) = if z % 2 == 0 { (4, 2) } else { (2, 4) };
+        for y in (0..side).step_by(sy as usize) {
+            for x in (0..side).step_by(sx as usize) {
+                order.push(Placement::new(brick, Cell::new(x, y, z), rot));
+            }
+        }
+    }
+    let mut a = Assembly::from_order(&order, 24, brickwright::catalog::Color::RED);
+    a.paint(Palette::Layers, 1);
+    a.regroup(StepGrouping::Auto);
+    a
+}
+
+fn bench(c: &mut Criterion) {
+    let template = Template::default();
+    let mut group = c.benchmark_group("booklet");
+    group.sample_size(10);
+    // 16 x 16 studs: 32 bricks a course; 24 x 24: 72.
+    for (side, courses) in [(16, 32), (24, 70)] {
+        let a = block(side, courses);
+        let n = a.pieces.len();
+        let size = f64::from(side);
+        let pictures = Pictures {
+            assembly: &a,
+            title: "block",
+            size_studs: [size, size, f64::from(courses)],
+            size_cm: [size * 0.8, size * 0.8, f64::from(courses) * 0.96],
+        };
+        group.bench_function(BenchmarkId::new("pieces", n), |b| {
+            b.iter(|| {
+                let rendered = render_all(&pictures, true).expect("renders");
+                booklet(&pictures, &rendered, &template).expect("lays out")
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
