@@ -13,7 +13,7 @@
 //! cargo bench --bench booklet -- --warm-up-time 1 --measurement-time 5
 //! ```
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_main, BenchmarkId, Criterion};
 
 use brickwright::assembly::{Assembly, Placement, StepGrouping};
 use brickwright::booklet::Template;
@@ -65,5 +65,11 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// Every benchmark, configured from the command line. Written out instead
+/// of `criterion_group!`, whose generated `pub fn` has no doc comment.
+fn benches() {
+    let mut c = Criterion::default().configure_from_args();
+    bench(&mut c);
+}
+
 criterion_main!(benches);
