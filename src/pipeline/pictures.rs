@@ -7,7 +7,6 @@
 //! the pictures of an assembly without a build.
 
 use std::collections::BTreeMap;
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use image::RgbaImage;
@@ -67,14 +66,8 @@ pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError
 
 /// Every step image, drawn incrementally in as many runs as threads.
 fn step_images(renderer: &StepRenderer) -> Vec<RgbaImage> {
-    let n = renderer.steps().len();
-    let runs = rayon::current_num_threads().clamp(1, n.max(1));
-    let per_run = n.div_ceil(runs).max(1);
-    let ranges: Vec<Range<usize>> = (0..n)
-        .step_by(per_run)
-        .map(|a| a..(a + per_run).min(n))
-        .collect();
-    ranges
+    renderer
+        .runs()
         .into_par_iter()
         .map(|r| {
             renderer

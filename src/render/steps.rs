@@ -239,6 +239,18 @@ impl StepRenderer {
         StepImages::new(Cow::Borrowed(self), range)
     }
 
+    /// The steps cut into one run a thread, for drawing runs in parallel
+    /// (each run incrementally, with [`images_in`](Self::images_in)).
+    pub fn runs(&self) -> Vec<Range<usize>> {
+        let n = self.steps.len();
+        let runs = rayon::current_num_threads().clamp(1, n.max(1));
+        let per_run = n.div_ceil(runs).max(1);
+        (0..n)
+            .step_by(per_run)
+            .map(|a| a..(a + per_run).min(n))
+            .collect()
+    }
+
     /// Writes `step-001.png`, `step-002.png`, ... (the step's number, at
     /// least three digits) into `dir`, created if missing, each file
     /// atomically, rendering in parallel. Returns the paths in step order.
@@ -247,7 +259,6 @@ impl StepRenderer {
             path: dir.to_path_buf(),
             source,
         })?;
-        let n = self.steps.len();
         let digits = self
             .steps
             .last()
@@ -258,13 +269,7 @@ impl StepRenderer {
             .iter()
             .map(|(s, _)| dir.join(format!("step-{:0digits$}.png", s.0)))
             .collect();
-        let runs = rayon::current_num_threads().clamp(1, n.max(1));
-        let per_run = n.div_ceil(runs).max(1);
-        let ranges: Vec<Range<usize>> = (0..n)
-            .step_by(per_run)
-            .map(|a| a..(a + per_run).min(n))
-            .collect();
-        ranges.into_par_iter().try_for_each(|range| {
+        self.runs().into_par_iter().try_for_each(|range| {
             for (k, (_, img)) in range.clone().zip(self.images_in(range)) {
                 self.write_png_file(&img, &paths[k])?;
             }
