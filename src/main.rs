@@ -107,6 +107,16 @@ enum StepBy {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum StabilityArg {
+    /// Check every step and fix what fails.
+    Repair,
+    /// Check every step; fail the build when one would not stand.
+    Check,
+    /// No check.
+    Off,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum ConditionArg {
     /// New parts.
     #[value(name = "N", alias = "n")]
@@ -159,8 +169,8 @@ struct BuildArgs {
     /// Use plates too, to follow the shape more closely (voxels become a plate high).
     #[arg(long)]
     plates: bool,
-    /// Put this many pieces in each step (default: one piece a step, or as few as keep a
-    /// big model within the 255 steps LeoCAD can show).
+    /// Put this many pieces in each step (default: a step per course, at most 8 pieces a
+    /// step, more only to keep a big model within the 255 steps LeoCAD can show).
     #[arg(long, conflicts_with = "step_by", value_parser = clap::value_parser!(u32).range(1..))]
     step_size: Option<u32>,
     /// Group steps another way.
@@ -187,6 +197,11 @@ struct BuildArgs {
     /// like templates/default.toml; default the built-in one.
     #[arg(long, value_name = "FILE")]
     template: Option<PathBuf>,
+    /// Check that the build stands at every step (static forces, clutch at the studs):
+    /// repair fixes what fails (another layout, or weak pieces moved to later steps),
+    /// check fails the build when a step would not stand, off skips the check.
+    #[arg(long, value_enum, default_value_t = StabilityArg::Repair)]
+    stability: StabilityArg,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -249,6 +264,11 @@ fn run_build(a: BuildArgs) -> Result<()> {
     });
     opts.formats = a.formats;
     opts.template = a.template;
+    opts.stability = match a.stability {
+        StabilityArg::Repair => pipeline::Stability::Repair,
+        StabilityArg::Check => pipeline::Stability::Check,
+        StabilityArg::Off => pipeline::Stability::Off,
+    };
     opts.search = opts
         .search
         .with_seed(a.seed)
@@ -329,13 +349,34 @@ fn run_build(a: BuildArgs) -> Result<()> {
             r.seams.seams,
             100.0 * r.seams.fraction
         );
+        if let Some(st) = &r.stability {
+            print_stability(st);
+        }
         let s = &r.seconds;
         outln!(
-            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, render {:.2}s, booklet {:.2}s, write {:.2}s",
-            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.render, s.booklet, s.write
+            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, stability {:.2}s, render {:.2}s, booklet {:.2}s, write {:.2}s",
+            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.stability, s.render, s.booklet, s.write
         );
     }
     Ok(())
+}
+
+/// The stability lines of the build summary.
+fn print_stability(st: &pipeline::StabilityReport) {
+    let verdict = match st.first_failure {
+        None => "stands at every step".to_string(),
+        Some(step) => format!("warning: does not stand from step {step} on"),
+    };
+    outln!(
+        "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} analyses)",
+        st.min_score, st.mean_score, st.solves
+    );
+    for line in &st.repairs {
+        outln!("  repaired {line}");
+    }
+    if let Some(reason) = &st.failure {
+        outln!("  warning: {reason}");
+    }
 }
 
 /// A height of `layers` layers `layer_ldu` high, in bricks (24 LDU).

@@ -9,6 +9,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub mod pictures;
+pub mod stability;
+
+pub use stability::{Stability, StabilityReport};
 
 use serde::Serialize;
 use thiserror::Error;
@@ -64,6 +67,8 @@ pub struct BuildOptions {
     /// The booklet's layout template; `None` for the built-in
     /// `templates/default.toml`.
     pub template: Option<PathBuf>,
+    /// The stability stage. Default [`Stability::Repair`].
+    pub stability: Stability,
 }
 
 /// A file `brickwright build` can write.
@@ -91,11 +96,15 @@ pub enum Format {
     ExplodedPng,
     /// `<stem>.pdf`: the printable instruction booklet.
     Pdf,
+    /// `<stem>-stress.png`: the finished model, each piece coloured by
+    /// the share of its clutch used (green none, red all); needs the
+    /// stability check.
+    Stress,
 }
 
 impl Format {
     /// Every format, in the order files are written.
-    pub const ALL: [Format; 10] = [
+    pub const ALL: [Format; 11] = [
         Format::Ldr,
         Format::Glb,
         Format::ExplodedGlb,
@@ -106,6 +115,7 @@ impl Format {
         Format::Png,
         Format::ExplodedPng,
         Format::Pdf,
+        Format::Stress,
     ];
 
     /// Whether `--formats all` (and the default) includes it: every format
@@ -127,6 +137,7 @@ impl Format {
             Format::Png => "png",
             Format::ExplodedPng => "exploded-png",
             Format::Pdf => "pdf",
+            Format::Stress => "stress",
         }
     }
 
@@ -143,6 +154,7 @@ impl Format {
             Format::Png => format!("{stem}.png"),
             Format::ExplodedPng => format!("{stem}-exploded.png"),
             Format::Pdf => format!("{stem}.pdf"),
+            Format::Stress => format!("{stem}-stress.png"),
         }
     }
 }
@@ -217,6 +229,7 @@ impl BuildOptions {
             condition: None,
             formats: Formats::default(),
             template: None,
+            stability: Stability::default(),
         }
     }
 }
@@ -260,6 +273,20 @@ pub enum BuildError {
         /// What failed.
         report: String,
     },
+    /// The force analysis failed (a solver failure, never bad input).
+    #[error("stability analysis: {0}")]
+    Physics(crate::physics::PhysicsError),
+    /// `--stability check` found a step that would not stand.
+    #[error("{file}: {reason} (--stability repair fixes what it can; --stability off skips the check)")]
+    Unstable {
+        /// The input file.
+        file: String,
+        /// Which step fails, and the weak pieces.
+        reason: String,
+    },
+    /// Options that do not go together.
+    #[error("{0}")]
+    Options(String),
     /// An output could not be written.
     #[error("{path}: cannot write: {reason}")]
     Write {
@@ -287,6 +314,8 @@ pub struct StageTimes {
     pub render: f64,
     /// Laying out the booklet.
     pub booklet: f64,
+    /// The stability check of every step, and its repairs.
+    pub stability: f64,
     /// Writing outputs.
     pub write: f64,
 }
@@ -328,6 +357,9 @@ pub struct BuildReport {
     pub steps: u32,
     /// Pages of the booklet, when one was written.
     pub booklet_pages: Option<usize>,
+    /// The stability check of every step and what its repair changed;
+    /// `None` with `--stability off`.
+    pub stability: Option<StabilityReport>,
     /// The build order: `by course` (the search's pieces re-sequenced
     /// course by course, verified) or `search trace` (when the
     /// re-sequenced order did not verify).
@@ -367,6 +399,8 @@ pub struct ReportOptions {
     pub palette: String,
     /// The wanted list's condition: `N`, `U`, or `any`.
     pub condition: String,
+    /// The stability stage: `repair`, `check` or `off`.
+    pub stability: Stability,
     /// The files asked for.
     pub formats: Formats,
 }
@@ -414,6 +448,14 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let file = opts.input.display().to_string();
     let mut times = StageTimes::default();
 
+    if opts.stability == Stability::Off
+        && opts.formats.contains(Format::Stress)
+        && opts.formats != Formats::default()
+    {
+        return Err(BuildError::Options(
+            "--formats stress needs the stability check; drop --stability off".into(),
+        ));
+    }
     // Rules first: a bad rule file should fail before any slow work.
     let t = Instant::now();
     let rules = load_rules(opts.rules.as_deref())?.restricted(|p| match p.spec().family() {
@@ -448,38 +490,64 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     progress.stage("searching");
     let t = Instant::now();
-    let outcome = search::build_guided(&model.grid, Some(&model.slant), &rules, &opts.search)
-        .map_err(|reason| BuildError::Search {
-            file: file.clone(),
-            reason,
-        })?;
-    times.search = secs(t);
+    // Search, verify, re-sequence and group: the plan every output
+    // follows. The stability repair may ask for another seed's plan.
+    let verify_secs = std::cell::Cell::new(0.0);
+    let plan = |seed: u64| -> Result<stability::Plan, BuildError> {
+        let search_opts = opts.search.clone().with_seed(seed);
+        let outcome = search::build_guided(&model.grid, Some(&model.slant), &rules, &search_opts)
+            .map_err(|reason| BuildError::Search {
+                file: file.clone(),
+                reason,
+            })?;
+        let t = Instant::now();
+        let order = search::placements(&outcome);
+        let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
+        assembly.paint(opts.palette, seed);
+        let check = verify(&assembly, Some(&outcome.voxels));
+        if !check.is_ok() {
+            return Err(BuildError::Unverified {
+                file: file.clone(),
+                report: check.to_string(),
+            });
+        }
+        // Re-sequence course by course so steps read like instructions;
+        // keep the search's order if the re-sequenced one does not verify.
+        let by_course = crate::assembly::order::by_course(&assembly);
+        let order_name = if verify(&by_course, Some(&outcome.voxels)).is_ok() {
+            assembly = by_course;
+            "by course"
+        } else {
+            "search trace"
+        };
+        assembly.regroup(opts.steps);
+        verify_secs.set(verify_secs.get() + secs(t));
+        Ok((outcome, assembly, order_name))
+    };
+    let first = plan(opts.search.seed)?;
+    times.verify = verify_secs.get();
+    times.search = secs(t) - times.verify;
     progress.done();
 
-    progress.stage("verifying");
-    let t = Instant::now();
-    let order = search::placements(&outcome);
-    let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
-    assembly.paint(opts.palette, opts.search.seed);
-    let check = verify(&assembly, Some(&outcome.voxels));
-    if !check.is_ok() {
-        return Err(BuildError::Unverified {
-            file,
-            report: check.to_string(),
-        });
-    }
-    // Re-sequence course by course so steps read like instructions; keep
-    // the search's order if the re-sequenced one does not verify.
-    let by_course = crate::assembly::order::by_course(&assembly);
-    let order_name = if verify(&by_course, Some(&outcome.voxels)).is_ok() {
-        assembly = by_course;
-        "by course"
-    } else {
-        "search trace"
+    let ((outcome, assembly, order_name), stability) = match opts.stability {
+        Stability::Off => (first, None),
+        mode => {
+            progress.stage("checking stability");
+            let t = Instant::now();
+            let params = crate::physics::Params::default();
+            let (planned, report, finished) =
+                stability::settle(mode, first, opts.search.seed, &params, &plan)?;
+            if mode == Stability::Check && !report.stands {
+                return Err(BuildError::Unstable {
+                    file,
+                    reason: report.failure.clone().unwrap_or_default(),
+                });
+            }
+            times.stability = secs(t);
+            progress.done();
+            (planned, Some((report, finished)))
+        }
     };
-    assembly.regroup(opts.steps);
-    times.verify = secs(t);
-    progress.done();
 
     let stem = opts
         .input
@@ -588,6 +656,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 None => "any".into(),
             },
             formats: opts.formats.clone(),
+            stability: opts.stability,
         },
         triangles: mesh.triangles.len(),
         grid: [nx, ny, nz],
@@ -604,6 +673,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         booklet_pages: formats
             .contains(Format::Pdf)
             .then(|| crate::booklet::page_count(&assembly, &template)),
+        stability: stability.as_ref().map(|(r, _)| r.clone()),
         order: order_name.into(),
         size_cm,
         seconds: times,
@@ -630,6 +700,15 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 files.add(&path, |w| write_gltf(w, &assembly, &gltf))
             }
             Format::Bricklink => files.add(&path, |w| write_bricklink(w, &parts, opts.condition)),
+            Format::Stress => {
+                // Drawn only when the stability stage ran (`all` skips it
+                // under `--stability off`; naming it then is an error, above).
+                let Some((_, finished)) = &stability else {
+                    continue;
+                };
+                let png = pictures::encode(&pictures::stress_image(&assembly, finished)?);
+                files.add(&path, |w| w.write_all(&png))
+            }
             Format::Csv => files.add(&path, |w| write_rebrickable_csv(w, &parts)),
             Format::Steps | Format::Png | Format::ExplodedPng | Format::Pdf => {
                 let Some((rendered, booklet)) = &rendered else {
@@ -743,8 +822,12 @@ fn describe(opts: &BuildOptions) -> String {
         Palette::Layers => String::new(),
         p => format!(" --palette {}", p.describe()),
     };
+    let stability = match opts.stability {
+        Stability::Repair => String::new(),
+        s => format!(" --stability {}", s.name()),
+    };
     format!(
-        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}{palette}",
+        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}{palette}{stability}",
         opts.search.seed
     )
 }

@@ -184,3 +184,17 @@ pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::
     write_booklet(&mut pdf, &input, template)?;
     Ok(pdf)
 }
+
+/// The finished model with each piece coloured by the share of its clutch
+/// capacity used: green none, yellow half, red all (or falls).
+pub fn stress_image(
+    assembly: &Assembly,
+    analysis: &crate::physics::Analysis,
+) -> Result<RgbaImage, RenderError> {
+    let colors: Vec<_> = analysis
+        .pieces
+        .iter()
+        .map(|p| render::stress_color(if p.falls { f64::INFINITY } else { p.usage }))
+        .collect();
+    render::model_image_with_colors(assembly, &colors, &options())
+}
