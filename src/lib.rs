@@ -22,6 +22,8 @@
 //!   exploded views, glTF 2.0, BrickLink and Rebrickable parts lists.
 //! - [`render`] draws instruction images: step pictures and part pictures.
 //! - [`booklet`] lays out the printable PDF instructions.
+//! - [`physics`] checks that the build stands, step by step: static
+//!   forces, clutch usage and stability scores.
 //! - [`pipeline`] ties the stages together for the command-line tool.
 
 pub mod assembly;
@@ -33,6 +35,7 @@ pub mod geom;
 pub mod grammar;
 pub mod ldraw;
 pub mod mesh;
+pub mod physics;
 pub mod pipeline;
 pub mod render;
 pub mod search;

@@ -53,6 +53,13 @@ enum Command {
     Verify {
         /// The .ldr or .mpd file.
         file: PathBuf,
+        /// Also check that the build stands at every step (static forces and stud clutch);
+        /// fails when something would fall or break off.
+        #[arg(long)]
+        stability: bool,
+        /// What the lowest layer stands on, for --stability.
+        #[arg(long, value_enum, default_value_t = GroundArg::Table, requires = "stability")]
+        ground: GroundArg,
     },
     /// Write a generated rule file (the default rules, or every brick of the catalog).
     Rules {
@@ -90,6 +97,14 @@ enum Alphabet {
     Default,
     /// Every brick in the catalog (adds 1x6, 1x8, 2x6, 2x8).
     Extended,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GroundArg {
+    /// A table: it pushes up, never holds studs.
+    Table,
+    /// A baseplate: it also holds the lowest pieces' tubes.
+    Baseplate,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -389,23 +404,107 @@ fn fmt_bricks(layers: i32, layer_ldu: i32) -> String {
     }
 }
 
-fn run_verify(file: PathBuf) -> Result<bool> {
+fn run_verify(file: PathBuf, stability: Option<GroundArg>) -> Result<bool> {
     let model = brickwright::ldraw::read_ldr(&file)?;
     let asm = brickwright::ldraw::to_assembly(&model)?;
     let report = verify(&asm, None);
-    if report.is_ok() {
+    let sound = report.is_ok();
+    if sound {
         outln!(
             "{}: OK: {} pieces, {} steps, one connected build",
             file.display(),
             asm.pieces.len(),
             asm.step_count()
         );
-        Ok(true)
     } else {
         outln!("{}: {} problems", file.display(), report.failures.len());
         outln!("{report}");
-        Ok(false)
     }
+    let stands = match stability {
+        Some(ground) => print_stability(&file, &model, &asm, ground)?,
+        None => true,
+    };
+    Ok(sound && stands)
+}
+
+/// Prints the static force analysis of every step; whether it all stands.
+fn print_stability(
+    file: &std::path::Path,
+    model: &brickwright::ldraw::LdrModel,
+    asm: &brickwright::assembly::Assembly,
+    ground: GroundArg,
+) -> Result<bool> {
+    use brickwright::physics::{analyze_steps, Ground, Params};
+    let (ground, on) = match ground {
+        GroundArg::Table => (Ground::Table, "on a table"),
+        GroundArg::Baseplate => (Ground::Baseplate, "on a baseplate"),
+    };
+    let params = Params::default().with_ground(ground);
+    let s = analyze_steps(asm, &params, false)
+        .with_context(|| format!("{}: stability analysis", file.display()))?;
+    let a = &s.last;
+    let stands = s.first_failure.is_none();
+    outln!(
+        "{}: stability: {}: min score {:.3}, mean {:.3}, max clutch usage {:.3} (clutch {} N a stud, {on})",
+        file.display(),
+        if stands { "stands at every step" } else { "FAILS" },
+        a.min_score,
+        a.mean_score,
+        a.max_usage,
+        params.clutch_n
+    );
+    let describe = |i: usize| {
+        let p = &asm.pieces[i];
+        let st = &a.pieces[i];
+        let what = if st.falls {
+            "falls".to_string()
+        } else if st.breaks {
+            format!("breaks off, clutch usage {:.3}", st.usage)
+        } else {
+            format!("clutch usage {:.3}, score {:.3}", st.usage, st.score)
+        };
+        let line = model
+            .parts
+            .get(i)
+            .map_or_else(String::new, |r| format!("line {}, ", r.line));
+        format!(
+            "piece #{i} ({line}{}, step {}): {what}",
+            p.placement.part.spec().id,
+            p.step.0
+        )
+    };
+    if !a.pieces.is_empty() {
+        outln!("  weakest pieces of the finished build:");
+        for i in a.weakest(5) {
+            outln!("    {}", describe(i));
+        }
+    }
+    if let Some(step) = s.first_failure {
+        let check = s.steps.iter().find(|c| c.step == step);
+        outln!("  first failing step: {step}");
+        if let Some(c) = check {
+            for &i in c.weakest.iter().take(3) {
+                let p = &asm.pieces[i];
+                outln!(
+                    "    piece #{i} ({}{}, step {})",
+                    model
+                        .parts
+                        .get(i)
+                        .map_or_else(String::new, |r| format!("line {}, ", r.line)),
+                    p.placement.part.spec().id,
+                    p.step.0
+                );
+            }
+        }
+    }
+    outln!(
+        "  {} steps checked: {} programs solved, {} groups carried over, {:.2} s",
+        s.steps.len(),
+        s.solves,
+        s.reused,
+        s.seconds
+    );
+    Ok(stands)
 }
 
 fn run_rules(alphabet: Alphabet, output: Option<PathBuf>) -> Result<()> {
@@ -447,7 +546,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Build(a) => run_build(a).map(|()| true),
-        Command::Verify { file } => run_verify(file),
+        Command::Verify {
+            file,
+            stability,
+            ground,
+        } => run_verify(file, stability.then_some(ground)),
         Command::Rules { alphabet, output } => run_rules(alphabet, output).map(|()| true),
         Command::Learn(a) => run_learn(a).map(|()| true),
     };

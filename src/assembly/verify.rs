@@ -236,21 +236,36 @@ fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
     failures
 }
 
-/// For each piece, the pieces it is stud-connected to (resting on its studs
-/// or holding it on theirs).
-fn connections(bodies: &[Body]) -> Vec<Vec<usize>> {
+/// Every pair `(below, above)` of pieces where `above`'s bottom layer lies
+/// right on `below`'s top layer and their footprints overlap: the pairs
+/// that can touch face to face, whether or not studs meet. Sorted by
+/// `below`, then `above`. [`connections`] keeps those where studs meet
+/// tubes; the physics stage also uses the others (compression only).
+pub fn stacked_pairs(bodies: &[Body]) -> Vec<(usize, usize)> {
     let mut by_bottom: HashMap<i32, Vec<usize>> = HashMap::new();
     for (i, b) in bodies.iter().enumerate() {
-        by_bottom.entry(b.tubes.min.z).or_default().push(i);
+        by_bottom.entry(b.bbox.min.z).or_default().push(i);
     }
-    let mut neighbours = vec![Vec::new(); bodies.len()];
+    let mut pairs = Vec::new();
     for (below, a) in bodies.iter().enumerate() {
-        let top = a.studs.min.z + 1;
+        let top = a.bbox.max_excl().z;
         for &above in by_bottom.get(&top).into_iter().flatten() {
-            if a.holds(&bodies[above]) {
-                neighbours[below].push(above);
-                neighbours[above].push(below);
+            if a.bbox.footprints_overlap(&bodies[above].bbox) {
+                pairs.push((below, above));
             }
+        }
+    }
+    pairs
+}
+
+/// For each piece, the pieces it is stud-connected to (resting on its studs
+/// or holding it on theirs): the [`stacked_pairs`] where [`Body::holds`].
+pub fn connections(bodies: &[Body]) -> Vec<Vec<usize>> {
+    let mut neighbours = vec![Vec::new(); bodies.len()];
+    for (below, above) in stacked_pairs(bodies) {
+        if bodies[below].holds(&bodies[above]) {
+            neighbours[below].push(above);
+            neighbours[above].push(below);
         }
     }
     neighbours

@@ -1,0 +1,364 @@
+//! Static force analysis: does the build stand, at every step, and how
+//! hard are its stud joints working?
+//!
+//! This follows the formulation of StableLego (R. Liu, K. Deng, Z. Wang,
+//! C. Liu, "StableLego: Stability Analysis of Block Stacking Assembly",
+//! arXiv:2402.10711, 2024), which BrickGPT (A. Pun et al., "Generating
+//! Physically Stable and Buildable Brick Structures from Text",
+//! arXiv:2505.05469, 2025) uses to check its generated builds: every piece
+//! must be in static equilibrium under gravity with the forces its contacts
+//! can give, and the tension a stud joint must carry is compared with the
+//! clutch friction a stud can hold.
+//!
+//! # The model
+//!
+//! Lengths are in studs (8 mm), forces are counted in clutch capacities of
+//! one stud ([`Params::clutch_n`] newtons), so the numbers the solver sees
+//! are all of order one.
+//!
+//! - **Gravity**: each piece weighs its catalog mass ([`PartSpec::mass_g`])
+//!   times [`Params::gravity`], at the centre of its filled boxes.
+//! - **Compression**: where a piece's bottom face rests on another's top
+//!   face, the lower piece may push the upper one up anywhere in the
+//!   overlap of the two faces, taken at the pieces' real outer edges (not
+//!   at stud centres). A force anywhere in a rectangle is a sum of forces
+//!   at its four corners, so there are four variables `c >= 0`.
+//! - **Clutch**: at each stud of the lower piece held in the upper piece's
+//!   tubes (the connection rule of [`verify`](crate::assembly::verify),
+//!   shared with it through [`stacked_pairs`](crate::assembly::verify::stacked_pairs)
+//!   and [`Body::holds`](crate::geom::Body::holds)), the clutch may pull
+//!   the two together with a tension `t >= 0` at the stud's centre, and
+//!   `t <= m_j` for the joint's usage `m_j` (the share of a stud's clutch
+//!   capacity the joint's most loaded stud uses).
+//! - **Ground**: a piece on layer 0 stands on a table ([`Ground::Table`],
+//!   the default): compression only, at the corners of its bottom face.
+//!   [`Ground::Baseplate`] adds clutch to the ground as StableLego has it.
+//! - **Side contacts** carry no force. Under gravity alone all contact
+//!   forces are vertical, so horizontal equilibrium holds trivially and a
+//!   side neighbour could only help (by friction); leaving it out is
+//!   conservative.
+//! - **Equilibrium**: for every piece, the vertical forces sum to zero and
+//!   so do their moments about the two horizontal axes through its centre
+//!   of mass (three equations a piece).
+//! - **Soft equilibrium**: StableLego minimises the equilibrium violation,
+//!   so its program always has an answer. Here every piece may also be held
+//!   by a "hand": an upward force anywhere under its bounding footprint
+//!   (four corner variables), priced far above any clutch usage. Since the
+//!   centre of mass lies inside the footprint, a hand can always hold a
+//!   piece, so the program is always feasible, and its equations stay
+//!   exact. A piece the hand has to hold (more than
+//!   [`Params::fall_tolerance`] of its weight) **falls**. (This needs four
+//!   variables a piece where residuals `r+ - r-` on three equations need
+//!   six.)
+//! - **Objective**: minimise `HAND_COST * sum(hand) + sum_j m_j +
+//!   1e-3 * sum(t)`: StableLego's sum of per-piece largest pull, plus a
+//!   little tension cost so that no tension is used where compression does.
+//!
+//! A piece's **usage** is the largest `m_j` over its joints; at 1 or more
+//! the joint **breaks** (the piece would come off). Its **score** is
+//! StableLego's stability score read the other way round, `1 - usage`,
+//! clamped to `[0, 1]`: 1 for a piece that needs no clutch, 0 for one that
+//! breaks off or falls. The model's minimum and mean score summarise it.
+//!
+//! Pieces that touch nowhere form separate groups (connected components,
+//! compression contacts included); each is its own program. A group that
+//! does not reach the ground falls as a whole.
+//!
+//! # The clutch capacity
+//!
+//! StableLego's `config.json` sets `T = 100` (grams-force, so 0.98 N) on
+//! each of the three or four contact points it puts in every stud, with
+//! compression at the same points. Our studs are one point each and our
+//! compression acts at the pieces' edges, which gives a longer lever; the
+//! default [`CLUTCH_N`] = 1.8 N a stud is the value that makes this model
+//! give StableLego's published verdicts on its staircase examples (a
+//! 19-step stair of 2 x 4 bricks on a baseplate stands, a 20-step one
+//! breaks: with our masses any value between 1.75 and 1.94 N does). It
+//! lies within the range of measured pull-off forces of a stud (about 1 to
+//! 3 N); set [`Params::clutch_n`] for other bricks.
+//!
+//! # Steps
+//!
+//! [`analyze_steps`] checks every intermediate build (the pieces of steps
+//! `1..=k`). It keeps a union-find of the groups as pieces are added; a
+//! group no piece of step `k` joined keeps its result from an earlier step,
+//! and only the groups that grew are solved, all steps' programs in
+//! parallel. (Clarabel is an interior-point solver with no warm start, so
+//! reuse is at the level of whole groups.)
+//!
+//! # Example
+//!
+//! ```
+//! use brickwright::assembly::{Assembly, Placement};
+//! use brickwright::catalog::{Color, PartKind};
+//! use brickwright::geom::{Cell, Rot};
+//! use brickwright::physics::{analyze, Params};
+//!
+//! let brick = PartKind::from_id("3001").unwrap();
+//! let order = [
+//!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+//!     Placement::new(brick, Cell::new(2, 0, 1), Rot::R0),
+//! ];
+//! let asm = Assembly::from_order(&order, 24, Color::RED);
+//! let a = analyze(&asm, &Params::default()).unwrap();
+//! assert!(a.stands());
+//! // The upper brick hangs half off: its clutch holds it.
+//! assert!(a.pieces[1].usage > 0.0 && a.pieces[1].usage < 1.0);
+//! ```
+
+mod model;
+mod steps;
+
+use serde::Serialize;
+
+#[cfg(doc)]
+use crate::catalog::PartSpec;
+
+use crate::assembly::Assembly;
+
+pub use steps::analyze_steps;
+
+/// Default clutch capacity of one stud, in newtons (see the module docs
+/// for where it comes from).
+pub const CLUTCH_N: f64 = 1.8;
+
+/// Standard gravity, m/s².
+pub const GRAVITY: f64 = 9.81;
+
+/// What the lowest layer stands on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Ground {
+    /// A table: it pushes up, never pulls (the default).
+    Table,
+    /// A baseplate: it pushes up and holds the studs it takes, as
+    /// StableLego's ground does.
+    Baseplate,
+}
+
+/// The physical constants of the analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Params {
+    /// Clutch capacity of one stud, in newtons (default [`CLUTCH_N`]).
+    pub clutch_n: f64,
+    /// Gravity, m/s² (default [`GRAVITY`]).
+    pub gravity: f64,
+    /// What the lowest layer stands on (default [`Ground::Table`]).
+    pub ground: Ground,
+    /// A piece falls when more than this share of its weight must be held
+    /// by hand (default 1e-3).
+    pub fall_tolerance: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            clutch_n: CLUTCH_N,
+            gravity: GRAVITY,
+            ground: Ground::Table,
+            fall_tolerance: 1e-3,
+        }
+    }
+}
+
+impl Params {
+    /// These parameters with a clutch capacity of `n` newtons a stud.
+    pub fn with_clutch_n(self, n: f64) -> Self {
+        Params {
+            clutch_n: n,
+            ..self
+        }
+    }
+
+    /// These parameters with the build standing on `ground`.
+    pub fn with_ground(self, ground: Ground) -> Self {
+        Params { ground, ..self }
+    }
+
+    /// These parameters with gravity `g` m/s².
+    pub fn with_gravity(self, g: f64) -> Self {
+        Params { gravity: g, ..self }
+    }
+
+    fn check(&self) -> Result<(), PhysicsError> {
+        let ok = |v: f64| v.is_finite() && v > 0.0;
+        if ok(self.clutch_n) && ok(self.gravity) && ok(self.fall_tolerance) {
+            Ok(())
+        } else {
+            Err(PhysicsError::Params(format!(
+                "clutch {} N, gravity {}, fall tolerance {}: each must be a positive number",
+                self.clutch_n, self.gravity, self.fall_tolerance
+            )))
+        }
+    }
+}
+
+/// How one piece fares.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PieceStress {
+    /// The share of a stud's clutch capacity its most loaded joint uses
+    /// (0 when it needs no clutch; 1 or more breaks).
+    pub usage: f64,
+    /// `1 - usage` clamped to `[0, 1]`; 0 when it falls or breaks off.
+    pub score: f64,
+    /// No force it can get holds it: it would fall (or tip over).
+    pub falls: bool,
+    /// A joint of it needs more clutch than the studs hold: it would break
+    /// off.
+    pub breaks: bool,
+}
+
+impl PieceStress {
+    /// A piece that falls with its group (no ground under the group).
+    fn falling() -> PieceStress {
+        PieceStress {
+            usage: 0.0,
+            score: 0.0,
+            falls: true,
+            breaks: false,
+        }
+    }
+
+    /// Whether it falls or breaks off.
+    pub fn fails(&self) -> bool {
+        self.falls || self.breaks
+    }
+
+    /// Sets `breaks` and `score` from `usage` and `falls`.
+    fn finish(&mut self) {
+        // Interior-point answers are exact to about 1e-8: snap the noise.
+        if self.usage < 1e-7 {
+            self.usage = 0.0;
+        }
+        self.breaks = self.usage >= 1.0;
+        self.score = if self.fails() {
+            0.0
+        } else {
+            (1.0 - self.usage).clamp(0.0, 1.0)
+        };
+    }
+}
+
+/// The analysis of one structure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Analysis {
+    /// Per piece, in the order of `assembly.pieces`.
+    pub pieces: Vec<PieceStress>,
+    /// The lowest score (1 for no pieces).
+    pub min_score: f64,
+    /// The mean score (1 for no pieces).
+    pub mean_score: f64,
+    /// The highest usage (0 for no pieces).
+    pub max_usage: f64,
+    /// Wall-clock seconds spent (building and solving).
+    pub solve_seconds: f64,
+}
+
+impl Analysis {
+    fn new(pieces: Vec<PieceStress>, solve_seconds: f64) -> Analysis {
+        let n = pieces.len();
+        let min_score = pieces.iter().map(|p| p.score).fold(1.0, f64::min);
+        let mean_score = if n == 0 {
+            1.0
+        } else {
+            pieces.iter().map(|p| p.score).sum::<f64>() / n as f64
+        };
+        let max_usage = pieces.iter().map(|p| p.usage).fold(0.0, f64::max);
+        Analysis {
+            pieces,
+            min_score,
+            mean_score,
+            max_usage,
+            solve_seconds,
+        }
+    }
+
+    /// Whether nothing falls or breaks off.
+    pub fn stands(&self) -> bool {
+        !self.pieces.iter().any(PieceStress::fails)
+    }
+
+    /// The indices of the `n` weakest pieces: lowest score first, then
+    /// highest usage, then build order.
+    pub fn weakest(&self, n: usize) -> Vec<usize> {
+        weakest(&self.pieces, n)
+    }
+}
+
+fn weakest(pieces: &[PieceStress], n: usize) -> Vec<usize> {
+    let mut idx: Vec<usize> = (0..pieces.len()).collect();
+    idx.sort_by(|&a, &b| {
+        let (p, q) = (&pieces[a], &pieces[b]);
+        p.score
+            .total_cmp(&q.score)
+            .then(q.usage.total_cmp(&p.usage))
+            .then(a.cmp(&b))
+    });
+    idx.truncate(n);
+    idx
+}
+
+/// One intermediate build: the pieces of steps `1..=step`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepCheck {
+    /// The step number.
+    pub step: u32,
+    /// The lowest score of the pieces placed so far.
+    pub min_score: f64,
+    /// Whether nothing placed so far falls or breaks off.
+    pub stands: bool,
+    /// Up to [`WEAKEST`] weakest pieces so far (indices into
+    /// `assembly.pieces`), weakest first.
+    pub weakest: Vec<usize>,
+}
+
+/// How many weakest pieces each [`StepCheck`] lists.
+pub const WEAKEST: usize = 5;
+
+/// The analysis of every step of a build.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepsAnalysis {
+    /// One check per step, in order (up to the first failure when asked
+    /// to stop there).
+    pub steps: Vec<StepCheck>,
+    /// The first step at which something falls or breaks off.
+    pub first_failure: Option<u32>,
+    /// The finished build's analysis (of the last step checked).
+    pub last: Analysis,
+    /// Wall-clock seconds for everything.
+    pub seconds: f64,
+    /// Programs solved.
+    pub solves: usize,
+    /// Groups whose result was carried over from an earlier step instead.
+    pub reused: usize,
+}
+
+/// Why an analysis failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PhysicsError {
+    /// The solver gave up on a group of pieces.
+    #[error(
+        "the force solver failed on a group of {pieces} pieces ({status}); \
+         the model may be too large or badly conditioned"
+    )]
+    Solver {
+        /// Pieces in the group.
+        pieces: usize,
+        /// The solver's status.
+        status: String,
+    },
+    /// Parameters out of range.
+    #[error("bad physics parameters: {0}")]
+    Params(String),
+    /// A bug: the program was built wrong.
+    #[error("internal error in the force analysis (a bug): {0}")]
+    Bug(String),
+}
+
+/// Analyses the finished build.
+pub fn analyze(assembly: &Assembly, params: &Params) -> Result<Analysis, PhysicsError> {
+    let start = std::time::Instant::now();
+    params.check()?;
+    let s = model::Structure::new(assembly, params);
+    let pieces = steps::solve_all(&s, assembly.pieces.len(), params)?;
+    Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
+}

@@ -1,0 +1,375 @@
+//! The force model: contacts between pieces, and one linear program per
+//! connected group of pieces, solved with Clarabel.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use crate::assembly::verify::stacked_pairs;
+use crate::assembly::Assembly;
+use crate::geom::{Body, CellBox};
+
+use super::{Ground, Params, PhysicsError, PieceStress};
+
+/// Cost of one clutch capacity's worth of "hand" force (force units are
+/// the clutch capacity of a stud): so high that the solver only reaches
+/// for a hand when no real force can hold the piece.
+const HAND_COST: f64 = 1e4;
+
+/// Cost of a unit of stud tension, so that the solver does not pull and
+/// push against itself where it need not.
+const TENSION_COST: f64 = 1e-3;
+
+/// A horizontal rectangle in stud units: `[x0, x1] x [y0, y1]`.
+#[derive(Debug, Clone, Copy)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Rect {
+    fn of(b: &CellBox) -> Rect {
+        Rect {
+            x0: f64::from(b.min.x),
+            y0: f64::from(b.min.y),
+            x1: f64::from(b.min.x + b.sx),
+            y1: f64::from(b.min.y + b.sy),
+        }
+    }
+
+    fn corners(&self) -> [(f64, f64); 4] {
+        [
+            (self.x0, self.y0),
+            (self.x1, self.y0),
+            (self.x0, self.y1),
+            (self.x1, self.y1),
+        ]
+    }
+}
+
+/// The footprint rectangle where two one-layer boxes' footprints overlap.
+fn overlap(a: &CellBox, b: &CellBox) -> Option<CellBox> {
+    let x0 = a.min.x.max(b.min.x);
+    let y0 = a.min.y.max(b.min.y);
+    let x1 = (a.min.x + a.sx).min(b.min.x + b.sx);
+    let y1 = (a.min.y + a.sy).min(b.min.y + b.sy);
+    (x0 < x1 && y0 < y1).then(|| CellBox {
+        min: crate::geom::Cell::new(x0, y0, a.min.z),
+        sx: x1 - x0,
+        sy: y1 - y0,
+        sz: 1,
+    })
+}
+
+/// Where two pieces touch: `above` rests on `below`.
+#[derive(Debug, Clone)]
+pub(super) struct Contact {
+    pub below: usize,
+    pub above: usize,
+    /// Where the faces press on each other (compression at its corners).
+    face: Option<Rect>,
+    /// The studs of `below` in `above`'s tubes, as cell centres.
+    studs: Vec<(f64, f64)>,
+}
+
+/// One piece's load and its support by the ground.
+#[derive(Debug, Clone)]
+struct Load {
+    /// Weight in clutch capacities of a stud.
+    weight: f64,
+    /// Centre of mass, in studs.
+    com: (f64, f64),
+    /// The piece's bounding footprint (where a hand may hold it).
+    extent: Rect,
+    /// Its bottom face on the ground, if it stands on it.
+    ground: Option<Rect>,
+    /// Its tubes on a baseplate's studs ([`Ground::Baseplate`] only).
+    ground_studs: Vec<(f64, f64)>,
+}
+
+/// The assembly seen as loads and contacts, built once.
+#[derive(Debug, Clone)]
+pub(super) struct Structure {
+    loads: Vec<Load>,
+    /// Sorted by the later piece (`max(below, above)`), then by the pair.
+    pub contacts: Vec<Contact>,
+}
+
+impl Structure {
+    pub fn new(asm: &Assembly, params: &Params) -> Structure {
+        let bodies: Vec<Body> = asm
+            .pieces
+            .iter()
+            .map(|p| p.placement.body(asm.layer_ldu))
+            .collect();
+        let loads = asm
+            .pieces
+            .iter()
+            .zip(&bodies)
+            .map(|(p, b)| load(b, p.placement.part.spec().mass_g, params))
+            .collect();
+        let mut contacts: Vec<Contact> = stacked_pairs(&bodies)
+            .into_iter()
+            .filter_map(|(below, above)| contact(&bodies, below, above))
+            .collect();
+        contacts.sort_by_key(|c| (c.below.max(c.above), c.below, c.above));
+        Structure { loads, contacts }
+    }
+
+    /// Whether the piece rests on the ground.
+    pub fn grounded(&self, piece: usize) -> bool {
+        self.loads[piece].ground.is_some()
+    }
+}
+
+fn load(b: &Body, mass_g: f32, params: &Params) -> Load {
+    let (mut v, mut mx, mut my) = (0.0, 0.0, 0.0);
+    for bx in b.boxes() {
+        let vol = f64::from(bx.volume());
+        let r = Rect::of(bx);
+        v += vol;
+        mx += vol * (r.x0 + r.x1) / 2.0;
+        my += vol * (r.y0 + r.y1) / 2.0;
+    }
+    let on_ground = b.bbox.min.z == 0;
+    let bottom = b.boxes()[0];
+    let ground_studs = if on_ground && params.ground == Ground::Baseplate {
+        b.tubes.cells().map(centre).collect()
+    } else {
+        Vec::new()
+    };
+    Load {
+        weight: f64::from(mass_g) / 1000.0 * params.gravity / params.clutch_n,
+        com: (mx / v, my / v),
+        extent: Rect::of(&b.bbox),
+        ground: on_ground.then(|| Rect::of(&bottom)),
+        ground_studs,
+    }
+}
+
+fn centre(c: crate::geom::Cell) -> (f64, f64) {
+    (f64::from(c.x) + 0.5, f64::from(c.y) + 0.5)
+}
+
+fn contact(bodies: &[Body], below: usize, above: usize) -> Option<Contact> {
+    let (a, b) = (&bodies[below], &bodies[above]);
+    let top = a.boxes().last().copied().unwrap_or(a.bbox);
+    let bottom = b.boxes()[0];
+    let face = if top.max_excl().z == bottom.min.z {
+        overlap(&top.layer_above(), &bottom).map(|r| Rect::of(&r))
+    } else {
+        None
+    };
+    let studs: Vec<(f64, f64)> = if a.holds(b) {
+        overlap(&a.over_studs(), &b.tubes)
+            .map(|r| r.cells().map(centre).collect())
+            .unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    (face.is_some() || !studs.is_empty()).then_some(Contact {
+        below,
+        above,
+        face,
+        studs,
+    })
+}
+
+/// A linear program under construction, one column at a time.
+struct Lp {
+    /// Column pointers, row indices and values of the constraint matrix.
+    colptr: Vec<usize>,
+    rowval: Vec<usize>,
+    nzval: Vec<f64>,
+    cost: Vec<f64>,
+    /// First row of the `x >= 0` block; row `nonneg + j` bounds column `j`.
+    nonneg: usize,
+    /// Next free row of the `t - m <= 0` block.
+    next_cap: usize,
+    entries: Vec<(usize, f64)>,
+}
+
+impl Lp {
+    fn column(&mut self, cost: f64, entries: &[(usize, f64)]) -> usize {
+        let j = self.cost.len();
+        self.entries.clear();
+        self.entries.extend_from_slice(entries);
+        self.entries.push((self.nonneg + j, -1.0));
+        self.entries.sort_by_key(|e| e.0);
+        for &(r, v) in &self.entries {
+            self.rowval.push(r);
+            self.nzval.push(v);
+        }
+        self.colptr.push(self.rowval.len());
+        self.cost.push(cost);
+        j
+    }
+}
+
+/// The three equilibrium rows of a piece: vertical force, then the
+/// moments about the axes through its centre of mass, for an upward force
+/// `f` at `(x, y)`.
+fn rows(local: usize, com: (f64, f64), (x, y): (f64, f64), f: f64) -> [(usize, f64); 3] {
+    [
+        (3 * local, f),
+        (3 * local + 1, f * (x - com.0)),
+        (3 * local + 2, f * (y - com.1)),
+    ]
+}
+
+/// The solved forces of one group of pieces.
+pub(super) struct Solved {
+    /// Per piece of the group, in the group's order.
+    pub stress: Vec<PieceStress>,
+}
+
+/// Solves the group `pieces` (sorted) with the `contacts` among them.
+pub(super) fn solve(
+    s: &Structure,
+    pieces: &[usize],
+    contacts: &[&Contact],
+    params: &Params,
+) -> Result<Solved, PhysicsError> {
+    let n = pieces.len();
+    let local = |p: usize| pieces.binary_search(&p).expect("piece of the group");
+    // Count the columns and the capacity rows first: the x >= 0 rows
+    // follow the equilibrium rows, the capacity rows follow those.
+    let mut cols = 4 * n;
+    let mut caps = 0;
+    for c in contacts {
+        cols += if c.face.is_some() { 4 } else { 0 };
+        if !c.studs.is_empty() {
+            cols += c.studs.len() + 1;
+            caps += c.studs.len();
+        }
+    }
+    for &p in pieces {
+        let l = &s.loads[p];
+        cols += if l.ground.is_some() { 4 } else { 0 };
+        if !l.ground_studs.is_empty() {
+            cols += l.ground_studs.len() + 1;
+            caps += l.ground_studs.len();
+        }
+    }
+    let eq = 3 * n;
+    let mut lp = Lp {
+        colptr: vec![0],
+        rowval: Vec::new(),
+        nzval: Vec::new(),
+        cost: Vec::with_capacity(cols),
+        nonneg: eq,
+        next_cap: eq + cols,
+        entries: Vec::new(),
+    };
+    // Joints: (first piece, second piece or none for the ground, column of m).
+    let mut joints: Vec<(usize, Option<usize>, usize)> = Vec::new();
+    let mut hands = Vec::with_capacity(n);
+    for (i, &p) in pieces.iter().enumerate() {
+        let l = &s.loads[p];
+        let first = lp.cost.len();
+        for corner in l.extent.corners() {
+            lp.column(HAND_COST, &rows(i, l.com, corner, 1.0));
+        }
+        hands.push(first);
+        if let Some(g) = l.ground {
+            for corner in g.corners() {
+                lp.column(0.0, &rows(i, l.com, corner, 1.0));
+            }
+        }
+        if !l.ground_studs.is_empty() {
+            let cap0 = lp.next_cap;
+            lp.next_cap += l.ground_studs.len();
+            for (k, &at) in l.ground_studs.iter().enumerate() {
+                let mut e = rows(i, l.com, at, -1.0).to_vec();
+                e.push((cap0 + k, 1.0));
+                lp.column(TENSION_COST, &e);
+            }
+            let caps_rows: Vec<(usize, f64)> = (0..l.ground_studs.len())
+                .map(|k| (cap0 + k, -1.0))
+                .collect();
+            let m = lp.column(1.0, &caps_rows);
+            joints.push((i, None, m));
+        }
+    }
+    for c in contacts {
+        let (a, b) = (local(c.below), local(c.above));
+        let (la, lb) = (&s.loads[c.below], &s.loads[c.above]);
+        if let Some(face) = c.face {
+            for at in face.corners() {
+                let mut e = rows(b, lb.com, at, 1.0).to_vec();
+                e.extend(rows(a, la.com, at, -1.0));
+                lp.column(0.0, &e);
+            }
+        }
+        if !c.studs.is_empty() {
+            let cap0 = lp.next_cap;
+            lp.next_cap += c.studs.len();
+            for (k, &at) in c.studs.iter().enumerate() {
+                let mut e = rows(b, lb.com, at, -1.0).to_vec();
+                e.extend(rows(a, la.com, at, 1.0));
+                e.push((cap0 + k, 1.0));
+                lp.column(TENSION_COST, &e);
+            }
+            let caps_rows: Vec<(usize, f64)> =
+                (0..c.studs.len()).map(|k| (cap0 + k, -1.0)).collect();
+            let m = lp.column(1.0, &caps_rows);
+            joints.push((a, Some(b), m));
+        }
+    }
+    debug_assert_eq!(lp.cost.len(), cols);
+    debug_assert_eq!(lp.next_cap, eq + cols + caps);
+    let m_rows = eq + cols + caps;
+    let mut b = vec![0.0; m_rows];
+    for (i, &p) in pieces.iter().enumerate() {
+        b[3 * i] = s.loads[p].weight;
+    }
+    let a = CscMatrix::new(m_rows, cols, lp.colptr, lp.rowval, lp.nzval);
+    let pm = CscMatrix::zeros((cols, cols));
+    let cones = [
+        SupportedConeT::ZeroConeT(eq),
+        SupportedConeT::NonnegativeConeT(cols + caps),
+    ];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_threads(1)
+        .build()
+        .map_err(|e| PhysicsError::Bug(format!("solver settings: {e}")))?;
+    let mut solver = DefaultSolver::new(&pm, &lp.cost, &a, &b, &cones, settings)
+        .map_err(|e| PhysicsError::Bug(format!("solver setup: {e:?}")))?;
+    solver.solve();
+    let status = solver.solution.status;
+    if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+        return Err(PhysicsError::Solver {
+            pieces: n,
+            status: format!("{status:?}"),
+        });
+    }
+    let x = &solver.solution.x;
+    let mut stress: Vec<PieceStress> = pieces
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let hand: f64 = x[hands[i]..hands[i] + 4].iter().sum();
+            let weight = s.loads[p].weight;
+            PieceStress {
+                usage: 0.0,
+                score: 1.0,
+                falls: hand > params.fall_tolerance * weight,
+                breaks: false,
+            }
+        })
+        .collect();
+    for &(a, b, m) in &joints {
+        let u = x[m].max(0.0);
+        for i in std::iter::once(a).chain(b) {
+            stress[i].usage = stress[i].usage.max(u);
+        }
+    }
+    for st in &mut stress {
+        st.finish();
+    }
+    Ok(Solved { stress })
+}

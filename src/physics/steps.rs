@@ -1,0 +1,217 @@
+//! Groups of touching pieces, kept as pieces are added step by step, and
+//! the parallel solving of the groups that grew.
+
+use rayon::prelude::*;
+
+use crate::assembly::Assembly;
+
+use super::model::{solve, Contact, Structure};
+use super::{weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis};
+
+/// Union-find over piece indices, with whether each group touches the
+/// ground.
+struct Groups {
+    parent: Vec<usize>,
+    grounded: Vec<bool>,
+}
+
+impl Groups {
+    fn new() -> Groups {
+        Groups {
+            parent: Vec::new(),
+            grounded: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, grounded: bool) {
+        self.parent.push(self.parent.len());
+        self.grounded.push(grounded);
+    }
+
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.parent[i] != i {
+            self.parent[i] = self.parent[self.parent[i]];
+            i = self.parent[i];
+        }
+        i
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // The smaller index becomes the root: deterministic.
+            let (root, child) = (ra.min(rb), ra.max(rb));
+            self.parent[child] = root;
+            self.grounded[root] |= self.grounded[child];
+        }
+    }
+}
+
+/// One program to solve: a group of the build after some step.
+struct Job {
+    /// Index of the step (into the step list) it belongs to.
+    step: usize,
+    /// The group's pieces, sorted.
+    pieces: Vec<usize>,
+    /// Indices into the structure's contacts.
+    contacts: Vec<usize>,
+    grounded: bool,
+}
+
+/// Advances the groups to the first `end` pieces and returns a job for
+/// every group that gained pieces, with `reused` counting the groups that
+/// did not.
+fn jobs_for_step(
+    s: &Structure,
+    g: &mut Groups,
+    next_contact: &mut usize,
+    end: usize,
+    step: usize,
+    reused: &mut usize,
+) -> Vec<Job> {
+    let start = g.parent.len();
+    for p in start..end {
+        g.add(s.grounded(p));
+    }
+    let mut c = *next_contact;
+    while c < s.contacts.len() && s.contacts[c].below.max(s.contacts[c].above) < end {
+        g.union(s.contacts[c].below, s.contacts[c].above);
+        c += 1;
+    }
+    *next_contact = c;
+    let mut touched: Vec<usize> = (start..end).map(|p| g.find(p)).collect();
+    touched.sort_unstable();
+    touched.dedup();
+    let roots: Vec<usize> = (0..end).map(|p| g.find(p)).collect();
+    let groups = roots.iter().enumerate().filter(|&(p, &r)| p == r).count();
+    *reused += groups - touched.len();
+    touched
+        .into_iter()
+        .map(|root| Job {
+            step,
+            pieces: (0..end).filter(|&p| roots[p] == root).collect(),
+            contacts: (0..c)
+                .filter(|&k| roots[s.contacts[k].below] == root)
+                .collect(),
+            grounded: g.grounded[root],
+        })
+        .collect()
+}
+
+/// Solves the jobs in parallel, in order: each job's stress per piece.
+fn run(
+    s: &Structure,
+    jobs: &[Job],
+    params: &Params,
+) -> Result<Vec<Vec<PieceStress>>, PhysicsError> {
+    jobs.par_iter()
+        .map(|job| {
+            if !job.grounded {
+                return Ok(vec![PieceStress::falling(); job.pieces.len()]);
+            }
+            let contacts: Vec<&Contact> = job.contacts.iter().map(|&k| &s.contacts[k]).collect();
+            solve(s, &job.pieces, &contacts, params).map(|r| r.stress)
+        })
+        .collect()
+}
+
+/// Every piece of the first `n` pieces, all groups solved (in parallel).
+pub(super) fn solve_all(
+    s: &Structure,
+    n: usize,
+    params: &Params,
+) -> Result<Vec<PieceStress>, PhysicsError> {
+    let mut g = Groups::new();
+    let (mut next, mut reused) = (0, 0);
+    let jobs = jobs_for_step(s, &mut g, &mut next, n, 0, &mut reused);
+    let results = run(s, &jobs, params)?;
+    let mut out = vec![PieceStress::falling(); n];
+    for (job, r) in jobs.iter().zip(results) {
+        for (&p, st) in job.pieces.iter().zip(r) {
+            out[p] = st;
+        }
+    }
+    Ok(out)
+}
+
+/// Analyses every intermediate build (the pieces of steps `1..=k`, for
+/// each step `k`), solving only the groups of pieces a step changed, and
+/// finds the first step at which something falls or breaks off. With
+/// `stop_at_first_failure`, stops there (solving a few steps ahead in
+/// parallel).
+pub fn analyze_steps(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+) -> Result<StepsAnalysis, PhysicsError> {
+    let start = std::time::Instant::now();
+    params.check()?;
+    let s = Structure::new(assembly, params);
+    // (step number, end of its pieces in build order).
+    let mut bounds: Vec<(u32, usize)> = Vec::new();
+    for (i, p) in assembly.pieces.iter().enumerate() {
+        match bounds.last_mut() {
+            Some((step, end)) if *step == p.step.0 => *end = i + 1,
+            _ => bounds.push((p.step.0, i + 1)),
+        }
+    }
+    let chunk = if stop_at_first_failure {
+        2 * rayon::current_num_threads()
+    } else {
+        bounds.len().max(1)
+    };
+    let mut g = Groups::new();
+    let (mut next, mut reused, mut solves) = (0, 0, 0);
+    let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
+    let mut steps = Vec::with_capacity(bounds.len());
+    let mut first_failure = None;
+    let mut end_checked = 0;
+    'chunks: for (c, chunk_bounds) in bounds.chunks(chunk).enumerate() {
+        let mut jobs = Vec::new();
+        for (k, &(_, end)) in chunk_bounds.iter().enumerate() {
+            jobs.extend(jobs_for_step(
+                &s,
+                &mut g,
+                &mut next,
+                end,
+                c * chunk + k,
+                &mut reused,
+            ));
+        }
+        solves += jobs.iter().filter(|j| j.grounded).count();
+        let results = run(&s, &jobs, params)?;
+        let mut at = 0;
+        for (k, &(step, end)) in chunk_bounds.iter().enumerate() {
+            while at < jobs.len() && jobs[at].step == c * chunk + k {
+                for (&p, &st) in jobs[at].pieces.iter().zip(&results[at]) {
+                    current[p] = st;
+                }
+                at += 1;
+            }
+            let placed = &current[..end];
+            let stands = !placed.iter().any(PieceStress::fails);
+            steps.push(StepCheck {
+                step,
+                min_score: placed.iter().map(|p| p.score).fold(1.0, f64::min),
+                stands,
+                weakest: weakest(placed, super::WEAKEST),
+            });
+            end_checked = end;
+            if !stands && first_failure.is_none() {
+                first_failure = Some(step);
+                if stop_at_first_failure {
+                    break 'chunks;
+                }
+            }
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(StepsAnalysis {
+        steps,
+        first_failure,
+        last: Analysis::new(current[..end_checked].to_vec(), seconds),
+        seconds,
+        solves,
+        reused,
+    })
+}

@@ -1,0 +1,305 @@
+//! Known answers of the static force analysis: structures whose verdict
+//! (and, where it is simple, whose clutch usage) can be worked out by hand,
+//! and the staircase examples StableLego publishes.
+//!
+//! Units in the hand computations: lengths in studs, weights in newtons
+//! (catalog mass x 9.81 m/s²), the default clutch T = 1.8 N a stud.
+
+use brickwright::assembly::{Assembly, Placed, Placement, Step, StepGrouping};
+use brickwright::catalog::{Color, PartKind};
+use brickwright::geom::{Cell, Rot};
+use brickwright::physics::{analyze, analyze_steps, Ground, Params, CLUTCH_N, GRAVITY};
+
+use Rot::{R0, R90};
+
+/// One piece: part, x, y, z (layer), turn, step.
+type P = (&'static str, i32, i32, i32, Rot, u32);
+
+/// An assembly on brick layers from pieces in build order.
+fn build(pieces: &[P]) -> Assembly {
+    Assembly {
+        pieces: pieces
+            .iter()
+            .map(|&(id, x, y, z, rot, step)| Placed {
+                placement: Placement::new(
+                    PartKind::from_id(id).expect("catalog part"),
+                    Cell::new(x, y, z),
+                    rot,
+                ),
+                step: Step(step),
+                color: Color::RED,
+            })
+            .collect(),
+        layer_ldu: 24,
+    }
+}
+
+/// The weight of a part in newtons.
+fn weight(id: &str) -> f64 {
+    f64::from(PartKind::from_id(id).unwrap().spec().mass_g) / 1000.0 * GRAVITY
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * b.abs()
+}
+
+#[test]
+fn a_brick_on_the_ground_stands_using_no_clutch() {
+    let a = analyze(&build(&[("3001", 0, 0, 0, R0, 1)]), &Params::default()).unwrap();
+    assert!(a.stands());
+    assert_eq!(a.pieces[0].usage, 0.0);
+    assert_eq!((a.min_score, a.mean_score, a.max_usage), (1.0, 1.0, 0.0));
+}
+
+#[test]
+fn a_balanced_t_on_a_column_stands_on_compression_alone() {
+    // A 2x2 column two bricks high; a 2x4 centred across its top.
+    let asm = build(&[
+        ("3003", 1, 0, 0, R0, 1),
+        ("3003", 1, 0, 1, R0, 2),
+        ("3001", 0, 0, 2, R0, 3),
+    ]);
+    let a = analyze(&asm, &Params::default()).unwrap();
+    assert!(a.stands(), "{a:?}");
+    for p in &a.pieces {
+        assert!(p.usage < 1e-4, "{a:?}");
+    }
+}
+
+/// A cantilever on a baseplate: a 2x4 base on the plate at x 0..4; a 2xL
+/// arm one brick up from x 3 (one column of 2 studs on the base, reaching
+/// L - 1 studs out); on the arm's far end, `h` 2x4 bricks turned across
+/// (2 studs along x) stacked as a load.
+fn cantilever(arm: &'static str, len: i32, h: i32) -> Assembly {
+    let mut p: Vec<P> = vec![("3001", 0, 0, 0, R0, 1), (arm, 3, 0, 1, R0, 2)];
+    for k in 0..h {
+        p.push(("3001", len + 1, -1, 2 + k, R90, 3 + k as u32));
+    }
+    build(&p)
+}
+
+/// The usage of the arm's joint, by hand. The arm turns about the base's
+/// edge x = 4 (compression there); its two studs at x = 3.5 pull with t
+/// each, lever 0.5: 2 * 0.5 * t = M, so usage = t / T = M / T. The arm's
+/// centre is at 3 + L/2 (lever L/2 - 1); the load's at L + 2 (lever L - 2).
+fn cantilever_usage(arm: &str, len: i32, h: i32) -> f64 {
+    let l = f64::from(len);
+    let m = weight(arm) * (l / 2.0 - 1.0) + f64::from(h) * weight("3001") * (l - 2.0);
+    m / CLUTCH_N
+}
+
+#[test]
+fn a_cantilever_holds_at_a_short_reach_and_breaks_at_a_long_one() {
+    let params = Params::default().with_ground(Ground::Baseplate);
+    // Reach 6 studs to the load (a 2x6 arm): (0.0326 * 2 + 15 * 0.0228 * 4) / 1.8 = 0.79.
+    let short = analyze(&cantilever("2456", 6, 15), &params).unwrap();
+    let want = cantilever_usage("2456", 6, 15);
+    assert!((0.78..0.80).contains(&want), "{want}");
+    assert!(short.stands(), "{short:?}");
+    assert!(
+        close(short.pieces[1].usage, want, 0.01),
+        "{} vs {want}",
+        short.pieces[1].usage
+    );
+    // Reach 8 (a 2x8 arm): (0.0430 * 3 + 15 * 0.0228 * 6) / 1.8 = 1.21: it breaks off.
+    let long = analyze(&cantilever("3007", 8, 15), &params).unwrap();
+    let want = cantilever_usage("3007", 8, 15);
+    assert!((1.20..1.22).contains(&want), "{want}");
+    assert!(!long.stands());
+    let arm = long.pieces[1];
+    assert!(arm.breaks && !arm.falls, "{arm:?}");
+    assert!(close(arm.usage, want, 0.01), "{} vs {want}", arm.usage);
+    let mut weakest = long.weakest(2);
+    weakest.sort_unstable();
+    assert_eq!(weakest, [0, 1]);
+    // The base breaks with it (the same joint); the load is fine.
+    assert!(long.pieces[0].breaks);
+    assert!(long.pieces[2].usage < 1e-4);
+}
+
+#[test]
+fn a_bridge_stands_only_once_its_keystone_is_in() {
+    // Two 1x2 columns two bricks high at x 0..2 and 16..18 on a table, a
+    // 1x8 arm on each reaching for the middle (one stud on its column):
+    // each half's centre of mass, (2 * 0.80 * 1 + 2.92 * 5) / 4.52 = 3.58,
+    // lies past its column's edge at x = 2, so an arm alone tips its column
+    // over. A 1x4 keystone across the arms' ends joins the halves into a
+    // symmetric bridge whose centre is between the columns.
+    let asm = build(&[
+        ("3004", 0, 0, 0, R0, 1),
+        ("3004", 0, 0, 1, R0, 1),
+        ("3004", 16, 0, 0, R0, 2),
+        ("3004", 16, 0, 1, R0, 2),
+        ("3008", 1, 0, 2, R0, 3),
+        ("3008", 9, 0, 2, R0, 4),
+        ("3010", 7, 0, 3, R0, 5),
+    ]);
+    let params = Params::default();
+    let steps = analyze_steps(&asm, &params, false).unwrap();
+    let stands: Vec<bool> = steps.steps.iter().map(|s| s.stands).collect();
+    assert_eq!(stands, [true, true, false, false, true], "{steps:?}");
+    assert_eq!(steps.first_failure, Some(3));
+    assert!(steps.last.stands());
+    // The columns' groups are separate until the keystone: steps 3 and 4
+    // each re-solve only the half that grew.
+    assert!(steps.reused >= 2, "{steps:?}");
+    // The same answer when stopping early, and from scratch at the end.
+    let early = analyze_steps(&asm, &params, true).unwrap();
+    assert_eq!(early.first_failure, Some(3));
+    assert_eq!(early.steps.len(), 3);
+    let whole = analyze(&asm, &params).unwrap();
+    assert!(whole.stands());
+    assert_eq!(whole.pieces, steps.last.pieces);
+}
+
+/// A 1x4 base on a table, a 1x6 overhang clutched to its last stud
+/// (x 3..9, centre 6), a 1x2 counterweight on the base's other end
+/// (x 0..2, centre 1). Base and overhang alone: centre of mass
+/// (1.52 * 2 + 2.24 * 6) / 3.76 = 4.38, past the base's edge x = 4: it
+/// tips. With the counterweight: (3.04 + 13.44 + 0.80) / 4.56 = 3.79: it
+/// stands.
+fn overhang(counterweight_first: bool) -> Assembly {
+    let (o, c) = if counterweight_first { (3, 2) } else { (2, 3) };
+    let mut p = vec![
+        ("3010", 0, 0, 0, R0, 1),
+        ("3009", 3, 0, 1, R0, o),
+        ("3004", 0, 0, 1, R0, c),
+    ];
+    p.sort_by_key(|q| q.5);
+    build(&p)
+}
+
+#[test]
+fn an_overhang_falls_when_built_before_its_counterweight() {
+    let params = Params::default();
+    let wrong = analyze_steps(&overhang(false), &params, false).unwrap();
+    let stands: Vec<bool> = wrong.steps.iter().map(|s| s.stands).collect();
+    assert_eq!(stands, [true, false, true]);
+    assert_eq!(wrong.first_failure, Some(2));
+    assert!(wrong.last.stands());
+    let right = analyze_steps(&overhang(true), &params, false).unwrap();
+    assert!(right.steps.iter().all(|s| s.stands), "{right:?}");
+    assert_eq!(right.first_failure, None);
+    // The overhang's clutch: moment 2.24 g * 9.81 * (6 - 4) about the base
+    // edge on one stud at lever 0.5.
+    let want = weight("3009") * 2.0 / 0.5 / CLUTCH_N;
+    let got = right.last.pieces[2].usage;
+    assert!(close(got, want, 0.01), "{got} vs {want}");
+}
+
+#[test]
+fn a_piece_floating_in_the_air_falls() {
+    let asm = build(&[("3001", 0, 0, 0, R0, 1), ("3001", 10, 0, 3, R0, 2)]);
+    let a = analyze(&asm, &Params::default()).unwrap();
+    assert!(!a.stands());
+    assert!(!a.pieces[0].falls && a.pieces[1].falls);
+    assert_eq!(a.pieces[1].score, 0.0);
+    assert_eq!(a.weakest(1), [1]);
+}
+
+#[test]
+fn a_leaning_tower_tips_over_once_its_centre_passes_its_base() {
+    // 1x4 bricks each two studs further right: the centre of k bricks is
+    // at 2 + (k - 1), past the base's edge x = 4 from k = 4 on.
+    let stair = |k: i32| -> Assembly {
+        let p: Vec<P> = (0..k)
+            .map(|i| ("3010", 2 * i, 0, i, R0, 1 + i as u32))
+            .collect();
+        build(&p)
+    };
+    let params = Params::default();
+    assert!(analyze(&stair(2), &params).unwrap().stands());
+    let four = analyze(&stair(4), &params).unwrap();
+    assert!(four.pieces.iter().any(|p| p.falls), "{four:?}");
+    let steps = analyze_steps(&stair(5), &params, false).unwrap();
+    assert_eq!(steps.first_failure, Some(4));
+}
+
+/// StableLego's staircases (`stair_19`, `stair_20`, `stair_20_good` in its
+/// `test_lego/`): 2x4 bricks, each two studs further along x and one
+/// brick up, on a baseplate.
+fn stair(n: i32, prop: bool) -> Assembly {
+    let mut p: Vec<P> = (0..n)
+        .map(|k| ("3001", 2 * k, 0, k, R0, 1 + k as u32))
+        .collect();
+    if prop {
+        // A 1x2 across under the second brick's x = 4 column.
+        p.push(("3004", 4, 0, 0, R90, n as u32 + 1));
+    }
+    build(&p)
+}
+
+/// The usage of the joint between stair bricks 0 and 1 with `n` bricks,
+/// by hand: the N = n - 1 bricks above it have centres 2d - 2 studs past
+/// the pivot x = 4 (d = 1..N), a moment of N (N - 1) W; its four studs
+/// pull at levers 0.5 and 1.5 (two each): 4 T usage.
+fn stair_usage(n: i32) -> f64 {
+    let big = f64::from(n - 1);
+    big * (big - 1.0) * weight("3001") / (4.0 * CLUTCH_N)
+}
+
+#[test]
+fn stablelego_stairs_19_stands_20_breaks_and_a_prop_saves_20() {
+    let params = Params::default().with_ground(Ground::Baseplate);
+    let low = analyze(&stair(19, false), &params).unwrap();
+    assert!(low.stands(), "StableLego: stair_19 is stable");
+    assert!(
+        close(low.max_usage, stair_usage(19), 0.01),
+        "{}",
+        low.max_usage
+    );
+    let high = analyze(&stair(20, false), &params).unwrap();
+    assert!(!high.stands(), "StableLego: stair_20 collapses");
+    assert!(
+        close(high.max_usage, stair_usage(20), 0.01),
+        "{}",
+        high.max_usage
+    );
+    assert!(
+        high.pieces.iter().all(|p| !p.falls),
+        "it breaks, it does not tip"
+    );
+    let good = analyze(&stair(20, true), &params).unwrap();
+    assert!(good.stands(), "StableLego: stair_20_good is stable");
+    // On a table instead of a baseplate the stair tips over long before.
+    let table = analyze(&stair(19, false), &Params::default()).unwrap();
+    assert!(table.pieces.iter().any(|p| p.falls));
+}
+
+#[test]
+fn the_analysis_is_deterministic_and_steps_agree_with_the_whole() {
+    // A small running-bond block, four courses, grouped as `build` does.
+    let mut p: Vec<P> = Vec::new();
+    for z in 0..4 {
+        for y in (0..4).step_by(2) {
+            for x in (0..8).step_by(4) {
+                let off = if z % 2 == 0 { 0 } else { 2 };
+                p.push(("3001", x + off, y, z, R0, 1));
+            }
+        }
+    }
+    let mut asm = build(&p);
+    asm.regroup(StepGrouping::Auto);
+    let params = Params::default();
+    let a = analyze(&asm, &params).unwrap();
+    let b = analyze(&asm, &params).unwrap();
+    assert_eq!(a.pieces, b.pieces);
+    assert!(a.stands(), "{a:?}");
+    let s = analyze_steps(&asm, &params, false).unwrap();
+    assert_eq!(s.steps.len() as u32, asm.step_count());
+    assert_eq!(s.last.pieces, a.pieces);
+    // A course's bricks touch only side by side at first: separate groups.
+    assert!(s.solves >= asm.step_count() as usize, "{s:?}");
+}
+
+#[test]
+fn bad_parameters_are_an_error_not_a_panic() {
+    let asm = build(&[("3001", 0, 0, 0, R0, 1)]);
+    assert!(analyze(&asm, &Params::default().with_clutch_n(0.0)).is_err());
+    assert!(analyze(&asm, &Params::default().with_gravity(f64::NAN)).is_err());
+    let empty = build(&[]);
+    let a = analyze(&empty, &Params::default()).unwrap();
+    assert!(a.stands() && a.pieces.is_empty());
+    let s = analyze_steps(&empty, &Params::default(), true).unwrap();
+    assert!(s.steps.is_empty() && s.first_failure.is_none());
+}
