@@ -67,6 +67,21 @@ fn main() -> Result<()> {
     let t = Instant::now();
     let renderer = render::renderer(&asm, &ropts)?;
     let setup = t.elapsed().as_secs_f64();
+    let turned: Vec<String> = (0..renderer.steps().len())
+        .filter_map(|n| {
+            renderer
+                .turn_at(n)
+                .map(|q| format!("{} (+{} to {})", n + 1, q, renderer.step_turns(n)))
+        })
+        .collect();
+    eprintln!(
+        "view turned at steps: {}",
+        if turned.is_empty() {
+            "none".to_string()
+        } else {
+            turned.join(", ")
+        }
+    );
     std::fs::create_dir_all(&out)?;
     renderer.write_png_file(&renderer.model_image(), &out.join("model.png"))?;
     if !steps {

@@ -156,6 +156,34 @@ impl Camera {
         Camera::new(view, center, scale, width, height)
     }
 
+    /// This camera at `scale` pixels per LDU, the world point at the
+    /// image's centre kept there: how views of one model share a scale.
+    pub fn with_scale(&self, scale: f32) -> Camera {
+        if !(scale.is_finite() && scale > 0.0) {
+            return *self;
+        }
+        let centre = Vec2::new(self.width as f32, self.height as f32) / 2.0;
+        Camera {
+            scale,
+            offset: centre - (centre - self.offset) * (scale / self.scale),
+            ..*self
+        }
+    }
+
+    /// The same picture drawn `factor` times as large: an image of about
+    /// `factor` times the width and height (at least one pixel), every
+    /// point projected `factor` times as far from the corner.
+    pub(crate) fn resized(&self, factor: f32) -> Camera {
+        let side = |s: u32| ((s as f32 * factor).round() as u32).max(1);
+        Camera {
+            scale: self.scale * factor,
+            offset: self.offset * factor,
+            width: side(self.width),
+            height: side(self.height),
+            ..*self
+        }
+    }
+
     /// `(x, y, depth)`: image pixels (x right, y down) and LDU away from
     /// the viewer.
     #[inline]

@@ -13,7 +13,11 @@
 //!    (LDU, -Y up), each piece with its colour and step ([`Scene`]).
 //! 2. **Camera.** One orthographic [`Camera`] is fitted to the finished
 //!    model and shared by every image of it, so step images line up
-//!    ([`View`] sets azimuth, elevation and quarter turns).
+//!    ([`View`] sets azimuth, elevation and quarter turns). A step whose
+//!    new pieces that view hides is seen from it turned by quarter turns
+//!    about the vertical axis, at the same scale, and its image shows a
+//!    "turn the model" arrow ([`Turning`]; the view stays put over runs
+//!    of steps).
 //! 3. **Raster.** Triangles facing the viewer are filled at 2 x 2 (by
 //!    default) samples a pixel into a depth buffer that keeps, per sample,
 //!    the nearest piece and its face: visibility is exact whatever order
@@ -96,9 +100,12 @@
 
 mod camera;
 mod compose;
+mod marks;
 mod raster;
 mod scene;
 mod steps;
+mod stress;
+mod turn;
 
 use std::path::{Path, PathBuf};
 
@@ -113,6 +120,8 @@ pub use camera::{Camera, View};
 pub use raster::PixelRect;
 pub use scene::{Scene, ScenePiece, Triangle};
 pub use steps::{write_png, StepImages, StepRenderer};
+pub use stress::{draw_stress_legend, stress_color};
+pub use turn::Turning;
 
 use compose::Style;
 
@@ -158,6 +167,41 @@ pub fn write_steps(
 /// image.
 pub fn model_image(assembly: &Assembly, opts: &RenderOptions) -> Result<RgbaImage, RenderError> {
     Ok(renderer(assembly, opts)?.model_image())
+}
+
+/// The finished model with piece `i` of `assembly.pieces` in `colors[i]`
+/// instead of its own colour (shaded like any colour), as
+/// [`model_image`] draws it: for pictures that colour pieces by a
+/// measure, such as a stress picture with [`stress_color`].
+///
+/// Fails with [`RenderError::Colors`] unless there is one colour a piece.
+///
+/// ```
+/// use brickwright::assembly::{Assembly, Placement};
+/// use brickwright::catalog::{Color, PartKind};
+/// use brickwright::geom::{Cell, Rot};
+/// use brickwright::render::{self, stress_color, RenderOptions};
+///
+/// let brick = PartKind::from_id("3001").unwrap();
+/// let order = [
+///     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+///     Placement::new(brick, Cell::new(1, 0, 1), Rot::R90),
+/// ];
+/// let asm = Assembly::from_order(&order, 24, Color::RED);
+/// let colors = [stress_color(0.1), stress_color(0.9)];
+/// let opts = RenderOptions::default().with_size(200, 150);
+/// let mut img = render::model_image_with_colors(&asm, &colors, &opts).unwrap();
+/// render::draw_stress_legend(&mut img);
+/// assert_eq!(img.dimensions(), (200, 150));
+/// ```
+pub fn model_image_with_colors(
+    assembly: &Assembly,
+    colors: &[Rgb<u8>],
+    opts: &RenderOptions,
+) -> Result<RgbaImage, RenderError> {
+    let mut scene = Scene::from_assembly(assembly);
+    scene.recolor(colors)?;
+    Ok(StepRenderer::new(scene, opts)?.model_image())
 }
 
 /// One part alone in `color`, [`PART_IMAGE_SIZE`] pixels square on white,
@@ -232,6 +276,10 @@ pub struct RenderOptions {
     pub background: Background,
     /// How new pieces stand out. Default [`Highlight::Strong`].
     pub highlight: Highlight,
+    /// Whether step images may turn away from `view` to show pieces it
+    /// hides (`view` stays the base view, and the finished model is
+    /// always seen from it). Default [`Turning::Auto`].
+    pub turn: Turning,
 }
 
 impl Default for RenderOptions {
@@ -246,19 +294,21 @@ impl Default for RenderOptions {
             fade: 0.55,
             background: Background::White,
             highlight: Highlight::Strong,
+            turn: Turning::Auto,
         }
     }
 }
 
 impl RenderOptions {
     /// The options of [`part_image`]: [`PART_IMAGE_SIZE`] square, 3 x 3
-    /// samples a pixel, a small margin.
+    /// samples a pixel, a small margin, no turning.
     pub fn part_default() -> Self {
         RenderOptions {
             width: PART_IMAGE_SIZE,
             height: PART_IMAGE_SIZE,
             supersample: 3,
             margin: 6,
+            turn: Turning::Off,
             ..RenderOptions::default()
         }
     }
@@ -308,6 +358,11 @@ impl RenderOptions {
     /// With this highlight of new pieces.
     pub fn with_highlight(self, highlight: Highlight) -> Self {
         RenderOptions { highlight, ..self }
+    }
+
+    /// With this choice of turning the view.
+    pub fn with_turn(self, turn: Turning) -> Self {
+        RenderOptions { turn, ..self }
     }
 
     /// Checks every option's range.
@@ -412,6 +467,17 @@ pub enum RenderError {
         value: String,
         /// What it may be.
         expected: &'static str,
+    },
+    /// A picture coloured piece by piece was given the wrong number of
+    /// colours.
+    #[error(
+        "{got} colours for {expected} pieces: give one colour a piece, in the assembly's order"
+    )]
+    Colors {
+        /// Pieces in the model.
+        expected: usize,
+        /// Colours given.
+        got: usize,
     },
     /// An image could not be written.
     #[error("{}: cannot write the image: {source}", path.display())]

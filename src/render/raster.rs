@@ -139,6 +139,24 @@ impl Samples {
         }
     }
 
+    /// The samples of pixel rectangle `rect`, as a range of indices a
+    /// row.
+    pub(crate) fn rows(
+        &self,
+        rect: PixelRect,
+    ) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        let ss = self.ss;
+        let (x0, x1) = (
+            (rect.x0 as usize * ss).min(self.w),
+            (rect.x1 as usize * ss).min(self.w),
+        );
+        let (y0, y1) = (
+            (rect.y0 as usize * ss).min(self.h),
+            (rect.y1 as usize * ss).min(self.h),
+        );
+        (y0..y1).map(move |y| y * self.w + x0..y * self.w + x1.max(x0))
+    }
+
     /// Draws piece `index` of `scene`, culling faces turned away from the
     /// viewer.
     pub(crate) fn draw_piece(

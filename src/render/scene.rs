@@ -112,6 +112,21 @@ impl Scene {
         )
     }
 
+    /// Gives piece `i` colour `colors[i]`, for pictures that colour pieces
+    /// by a measure; fails unless there is one colour a piece.
+    pub fn recolor(&mut self, colors: &[Rgb<u8>]) -> Result<(), super::RenderError> {
+        if colors.len() != self.pieces.len() {
+            return Err(super::RenderError::Colors {
+                expected: self.pieces.len(),
+                got: colors.len(),
+            });
+        }
+        for (p, &c) in self.pieces.iter_mut().zip(colors) {
+            p.color = c;
+        }
+        Ok(())
+    }
+
     /// Every piece, in the order added.
     pub fn pieces(&self) -> &[ScenePiece] {
         &self.pieces
@@ -154,70 +169,71 @@ fn mesh_triangles(mesh: &PartMesh, transform: Affine3A) -> impl Iterator<Item = 
     })
 }
 
+/// The 12 outward-wound triangles of the axis-aligned box `lo..hi`.
+pub(crate) fn cuboid(lo: Vec3, hi: Vec3) -> Vec<Triangle> {
+    let c = |x: bool, y: bool, z: bool| {
+        Vec3::new(
+            if x { hi.x } else { lo.x },
+            if y { hi.y } else { lo.y },
+            if z { hi.z } else { lo.z },
+        )
+    };
+    // Each face: four corners counter-clockwise seen from outside.
+    let faces = [
+        [
+            c(true, false, false),
+            c(true, true, false),
+            c(true, true, true),
+            c(true, false, true),
+        ], // +X
+        [
+            c(false, false, false),
+            c(false, false, true),
+            c(false, true, true),
+            c(false, true, false),
+        ], // -X
+        [
+            c(false, true, false),
+            c(false, true, true),
+            c(true, true, true),
+            c(true, true, false),
+        ], // +Y
+        [
+            c(false, false, false),
+            c(true, false, false),
+            c(true, false, true),
+            c(false, false, true),
+        ], // -Y
+        [
+            c(false, false, true),
+            c(true, false, true),
+            c(true, true, true),
+            c(false, true, true),
+        ], // +Z
+        [
+            c(false, false, false),
+            c(false, true, false),
+            c(true, true, false),
+            c(true, false, false),
+        ], // -Z
+    ];
+    faces
+        .iter()
+        .flat_map(|[a, b, c, d]| {
+            [
+                Triangle::from_winding([*a, *b, *c]),
+                Triangle::from_winding([*a, *c, *d]),
+            ]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 pub(crate) mod test_geometry {
     //! Boxes for the renderer's own tests (the library's part meshes come
     //! from `export::partmesh`).
+    pub(crate) use super::cuboid;
     use super::*;
-
-    /// The 12 outward-wound triangles of the axis-aligned box `lo..hi`.
-    pub fn cuboid(lo: Vec3, hi: Vec3) -> Vec<Triangle> {
-        let c = |x: bool, y: bool, z: bool| {
-            Vec3::new(
-                if x { hi.x } else { lo.x },
-                if y { hi.y } else { lo.y },
-                if z { hi.z } else { lo.z },
-            )
-        };
-        // Each face: four corners counter-clockwise seen from outside.
-        let faces = [
-            [
-                c(true, false, false),
-                c(true, true, false),
-                c(true, true, true),
-                c(true, false, true),
-            ], // +X
-            [
-                c(false, false, false),
-                c(false, false, true),
-                c(false, true, true),
-                c(false, true, false),
-            ], // -X
-            [
-                c(false, true, false),
-                c(false, true, true),
-                c(true, true, true),
-                c(true, true, false),
-            ], // +Y
-            [
-                c(false, false, false),
-                c(true, false, false),
-                c(true, false, true),
-                c(false, false, true),
-            ], // -Y
-            [
-                c(false, false, true),
-                c(true, false, true),
-                c(true, true, true),
-                c(false, true, true),
-            ], // +Z
-            [
-                c(false, false, false),
-                c(false, true, false),
-                c(true, true, false),
-                c(true, false, false),
-            ], // -Z
-        ];
-        faces
-            .iter()
-            .flat_map(|[a, b, c, d]| {
-                [
-                    Triangle::from_winding([*a, *b, *c]),
-                    Triangle::from_winding([*a, *c, *d]),
-                ]
-            })
-            .collect()
-    }
 
     #[test]
     fn cuboid_normals_point_out() {

@@ -10,9 +10,14 @@
 //! width. The result is the same, byte for byte, as drawing step `k` from
 //! scratch.
 //!
-//! [`StepRenderer::write_steps`] cuts the steps into runs, one per
-//! thread, and renders the runs in parallel with rayon, each run from its
-//! own buffers.
+//! A step may be seen from the base view turned by quarter turns, to show
+//! pieces the base view hides (see [`Turning`](super::Turning)); a step
+//! whose view differs from the step before is drawn from scratch and gets
+//! the "turn the model" badge.
+//!
+//! [`StepRenderer::write_steps`] cuts the steps into runs of one view, at
+//! most one run's share of the steps per thread each, and renders the runs
+//! in parallel with rayon, each run from its own buffers.
 
 use std::borrow::Cow;
 use std::io::{self, Write};
@@ -25,26 +30,49 @@ use rayon::prelude::*;
 
 use super::camera::Camera;
 use super::compose::{class, compose, PieceLook, Style};
+use super::marks::draw_turn;
 use super::raster::{piece_rect, Light, PixelRect, Samples};
 use super::scene::Scene;
+use super::turn::{self, Turning};
 use super::{Background, Highlight, RenderError, RenderOptions};
 use crate::assembly::Step;
 use crate::fsutil::write_atomic;
 
-/// A scene with its fitted camera, ready to draw any step.
+/// One way of seeing the scene: a camera and what depends on it.
+#[derive(Debug, Clone)]
+struct Eye {
+    camera: Camera,
+    light: Light,
+    /// Screen box of every piece.
+    rects: Vec<PixelRect>,
+}
+
+impl Eye {
+    fn new(scene: &Scene, camera: Camera) -> Eye {
+        Eye {
+            light: Light::for_camera(&camera),
+            rects: (0..scene.pieces().len())
+                .map(|i| piece_rect(scene, i, &camera))
+                .collect(),
+            camera,
+        }
+    }
+}
+
+/// A scene with its fitted cameras, ready to draw any step.
 #[derive(Debug, Clone)]
 pub struct StepRenderer {
     scene: Scene,
-    camera: Camera,
-    light: Light,
+    /// The base view turned by 0 (always there), 1, 2 and 3 quarter turns.
+    eyes: Vec<Eye>,
+    /// Each step's view, an index of `eyes`.
+    step_turns: Vec<u8>,
     style: Style,
     supersample: u32,
     /// Piece indices ordered by step (stable).
     order: Vec<usize>,
     /// Each step and its pieces, as a range of `order`.
     steps: Vec<(Step, Range<usize>)>,
-    /// Screen box of every piece.
-    rects: Vec<PixelRect>,
     /// Pixels around a changed box that composing may touch.
     reach: u32,
     /// Whether PNGs carry alpha.
@@ -55,6 +83,11 @@ pub struct StepRenderer {
 
 impl StepRenderer {
     /// A renderer for `scene`, its camera fitted once to the whole scene.
+    ///
+    /// With [`Turning::Auto`] (the default), the steps whose new pieces
+    /// the view hides are seen from the base view turned (see
+    /// [`Turning`]); if any is, every view is fitted to the whole scene and
+    /// all share the smallest of their scales, so pieces keep their size.
     pub fn new(scene: Scene, opts: &RenderOptions) -> Result<StepRenderer, RenderError> {
         opts.validate()?;
         let camera = Camera::fit(
@@ -64,7 +97,18 @@ impl StepRenderer {
             opts.height,
             opts.margin,
         );
-        Ok(StepRenderer::with_camera(scene, camera, opts))
+        let mut r = StepRenderer::with_camera(scene, camera, opts);
+        if opts.turn == Turning::Auto && r.steps.len() > 1 {
+            let cameras =
+                turn::turned_cameras(&opts.view, &r.scene, opts.width, opts.height, opts.margin);
+            let turns = turn::choose(&turn::shown(&r.scene, &r.order, &r.steps, &cameras));
+            if turns.iter().any(|&t| t != 0) {
+                r.style = opts.style(&cameras[0]);
+                r.eyes = cameras.map(|c| Eye::new(&r.scene, c)).into();
+                r.step_turns = turns;
+            }
+        }
+        Ok(r)
     }
 
     /// A renderer for `scene` seen through `camera` (whose size wins over
@@ -82,29 +126,55 @@ impl StepRenderer {
                 _ => steps.push((step, k..k + 1)),
             }
         }
-        let rects = (0..scene.pieces().len())
-            .map(|i| piece_rect(&scene, i, &camera))
-            .collect();
         let ss = opts.supersample;
         let reach = (style.radius_new as u32 + 2).div_ceil(ss) + 1;
         StepRenderer {
-            light: Light::for_camera(&camera),
+            eyes: vec![Eye::new(&scene, camera)],
+            step_turns: vec![0; steps.len()],
             scene,
-            camera,
             style,
             supersample: ss,
             order,
             steps,
-            rects,
             reach,
             alpha: opts.background == Background::Transparent,
             highlight: opts.highlight,
         }
     }
 
-    /// The camera every image of this renderer shares.
+    /// The camera of the base view: of the finished model and of every
+    /// step not turned.
     pub fn camera(&self) -> &Camera {
-        &self.camera
+        &self.eyes[0].camera
+    }
+
+    /// Quarter turns (0 to 3) from the base view of step number `n`'s
+    /// view (counted from 0 in [`StepRenderer::steps`]; 0 past the last
+    /// step). A quarter turn walks the viewer around the model the way
+    /// [`View::turned`](super::View::turned) does.
+    pub fn step_turns(&self, n: usize) -> u8 {
+        self.step_turns.get(n).copied().unwrap_or(0)
+    }
+
+    /// The camera of step number `n`'s image (the base camera past the
+    /// last step).
+    pub fn step_camera(&self, n: usize) -> &Camera {
+        &self.eye(n).camera
+    }
+
+    /// Quarter turns (1 to 3) from the previous step's view to step number
+    /// `n`'s (from the base view for the first step), or `None` when the
+    /// view did not turn. A step that turned shows the "turn the model"
+    /// badge in a corner of its image.
+    pub fn turn_at(&self, n: usize) -> Option<u8> {
+        let before = n.checked_sub(1).map_or(0, |m| self.step_turns(m));
+        let turns = (self.step_turns(n) + 4 - before) % 4;
+        (n < self.steps.len() && turns != 0).then_some(turns)
+    }
+
+    /// The view of step number `n`.
+    fn eye(&self, n: usize) -> &Eye {
+        &self.eyes[usize::from(self.step_turns(n)).min(self.eyes.len() - 1)]
     }
 
     /// The scene being drawn.
@@ -118,26 +188,29 @@ impl StepRenderer {
     }
 
     /// The screen box (pixels) of the pieces step number `n` (counted
-    /// from 0 in [`StepRenderer::steps`]) adds; empty past the last step.
+    /// from 0 in [`StepRenderer::steps`]) adds, in its own view; empty past
+    /// the last step.
     pub fn step_rect(&self, n: usize) -> PixelRect {
+        let rects = &self.eye(n).rects;
         self.steps.get(n).map_or(PixelRect::EMPTY, |(_, r)| {
             self.order[r.clone()]
                 .iter()
-                .fold(PixelRect::EMPTY, |acc, &i| acc.union(self.rects[i]))
+                .fold(PixelRect::EMPTY, |acc, &i| acc.union(rects[i]))
         })
     }
 
     /// The pixel rectangles to compose again when step number `n` follows
-    /// step `n - 1`: around each piece of both steps, or one box around
-    /// them all when that is smaller.
+    /// step `n - 1` in the same view: around each piece of both steps, or
+    /// one box around them all when that is smaller.
     fn dirty_rects(&self, n: usize) -> Vec<PixelRect> {
-        let (w, h) = (self.camera.width(), self.camera.height());
+        let eye = self.eye(n);
+        let (w, h) = (eye.camera.width(), eye.camera.height());
         let area = |r: &PixelRect| u64::from(r.x1 - r.x0) * u64::from(r.y1 - r.y0);
         let rects: Vec<PixelRect> = [n.wrapping_sub(1), n]
             .into_iter()
             .filter_map(|m| self.steps.get(m))
             .flat_map(|(_, range)| self.order[range.clone()].iter())
-            .map(|&i| self.rects[i].grown(self.reach, w, h))
+            .map(|&i| eye.rects[i].grown(self.reach, w, h))
             .filter(|r| !r.is_empty())
             .collect();
         let union = rects.iter().fold(PixelRect::EMPTY, |a, &r| a.union(r));
@@ -148,21 +221,27 @@ impl StepRenderer {
         }
     }
 
-    /// The screen box (pixels) of scene piece `i`.
+    /// The screen box (pixels) of scene piece `i` in the base view.
     pub fn piece_rect(&self, i: usize) -> PixelRect {
-        self.rects.get(i).copied().unwrap_or(PixelRect::EMPTY)
+        self.eyes[0]
+            .rects
+            .get(i)
+            .copied()
+            .unwrap_or(PixelRect::EMPTY)
     }
 
     fn blank(&self) -> RgbaImage {
+        let camera = self.camera();
         RgbaImage::from_pixel(
-            self.camera.width(),
-            self.camera.height(),
+            camera.width(),
+            camera.height(),
             image::Rgba(self.style.background),
         )
     }
 
     fn samples(&self) -> Samples {
-        Samples::new(self.camera.width(), self.camera.height(), self.supersample)
+        let camera = self.camera();
+        Samples::new(camera.width(), camera.height(), self.supersample)
     }
 
     /// The looks of every piece when step number `n` is shown.
@@ -185,10 +264,11 @@ impl StepRenderer {
             .collect()
     }
 
-    fn draw_step(&self, samples: &mut Samples, n: usize) {
+    /// Draws the pieces of step number `n` seen through `eye`.
+    fn draw_step(&self, samples: &mut Samples, n: usize, eye: &Eye) {
         if let Some((_, r)) = self.steps.get(n) {
             for &i in &self.order[r.clone()] {
-                samples.draw_piece(&self.scene, i, &self.camera, &self.light);
+                samples.draw_piece(&self.scene, i, &eye.camera, &eye.light);
             }
         }
     }
@@ -197,7 +277,7 @@ impl StepRenderer {
     pub fn model_image(&self) -> RgbaImage {
         let mut samples = self.samples();
         for n in 0..self.steps.len() {
-            self.draw_step(&mut samples, n);
+            self.draw_step(&mut samples, n, &self.eyes[0]);
         }
         let mut img = self.blank();
         let full = PixelRect {
@@ -239,16 +319,22 @@ impl StepRenderer {
         StepImages::new(Cow::Borrowed(self), range)
     }
 
-    /// The steps cut into one run a thread, for drawing runs in parallel
-    /// (each run incrementally, with [`images_in`](Self::images_in)).
+    /// The steps cut into runs for drawing in parallel (each run
+    /// incrementally, with [`images_in`](Self::images_in)): runs of one
+    /// view, each at most a thread's share of the steps.
     pub fn runs(&self) -> Vec<Range<usize>> {
         let n = self.steps.len();
-        let runs = rayon::current_num_threads().clamp(1, n.max(1));
-        let per_run = n.div_ceil(runs).max(1);
-        (0..n)
-            .step_by(per_run)
-            .map(|a| a..(a + per_run).min(n))
-            .collect()
+        let threads = rayon::current_num_threads().clamp(1, n.max(1));
+        let per_run = n.div_ceil(threads).max(1);
+        let mut runs = Vec::new();
+        let mut start = 0;
+        for end in 1..=n {
+            if end == n || end - start == per_run || self.turn_at(end).is_some() {
+                runs.push(start..end);
+                start = end;
+            }
+        }
+        runs
     }
 
     /// Writes `step-001.png`, `step-002.png`, ... (the step's number, at
@@ -310,7 +396,8 @@ pub fn write_png(img: &RgbaImage, alpha: bool, w: &mut dyn Write) -> io::Result<
 #[derive(Debug)]
 pub struct StepImages<'a> {
     renderer: Cow<'a, StepRenderer>,
-    samples: Option<Samples>,
+    /// The samples so far, and the view (quarter turns) they were drawn in.
+    samples: Option<(Samples, u8)>,
     image: RgbaImage,
     next: usize,
     end: usize,
@@ -339,17 +426,19 @@ impl Iterator for StepImages<'_> {
         let r = &*self.renderer;
         let n = self.next;
         let looks = r.looks(n);
+        let turns = r.step_turns(n);
+        let eye = r.eye(n);
         match &mut self.samples {
-            Some(samples) => {
-                r.draw_step(samples, n);
+            Some((samples, t)) if *t == turns => {
+                r.draw_step(samples, n, eye);
                 for rect in r.dirty_rects(n) {
                     compose(samples, &looks, &r.style, rect, &mut self.image);
                 }
             }
-            None => {
+            _ => {
                 let mut samples = r.samples();
                 for m in 0..=n {
-                    r.draw_step(&mut samples, m);
+                    r.draw_step(&mut samples, m, eye);
                 }
                 self.image = r.blank();
                 let (w, h) = (self.image.width(), self.image.height());
@@ -360,11 +449,17 @@ impl Iterator for StepImages<'_> {
                     y1: h,
                 };
                 compose(&samples, &looks, &r.style, full, &mut self.image);
-                self.samples = Some(samples);
+                self.samples = Some((samples, turns));
             }
         }
         self.next += 1;
-        Some((r.steps[n].0, self.image.clone()))
+        // The badge goes on the image handed out only: the kept image is
+        // composed on by the next step.
+        let mut out = self.image.clone();
+        if let Some(turned) = r.turn_at(n) {
+            draw_turn(&mut out, turned, r.style.background);
+        }
+        Some((r.steps[n].0, out))
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
