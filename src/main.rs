@@ -365,7 +365,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
             100.0 * r.seams.fraction
         );
         if let Some(st) = &r.stability {
-            print_stability(st);
+            print_build_stability(st);
         }
         let s = &r.seconds;
         outln!(
@@ -377,7 +377,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
 }
 
 /// The stability lines of the build summary.
-fn print_stability(st: &pipeline::StabilityReport) {
+fn print_build_stability(st: &pipeline::StabilityReport) {
     let verdict = match st.first_failure {
         None => "stands at every step".to_string(),
         Some(step) => format!("warning: does not stand from step {step} on"),
@@ -391,6 +391,13 @@ fn print_stability(st: &pipeline::StabilityReport) {
     }
     if let Some(reason) = &st.failure {
         outln!("  warning: {reason}");
+    }
+    match st.stands_on_baseplate {
+        Some(true) => outln!(
+            "  hint: it stands at every step when built on a baseplate, whose studs hold the bottom course"
+        ),
+        Some(false) => outln!("  (it would not stand on a baseplate either)"),
+        None => {}
     }
 }
 

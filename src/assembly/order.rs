@@ -6,11 +6,13 @@
 //! backward tracing peels pieces wherever a rule matched). A person builds
 //! a course, then the next; instructions that jump between courses make
 //! many tiny steps. [`by_course`] re-sequences the same pieces greedily:
-//! at each turn it adds, among the pieces stud-connected to what is
-//! already built, the one on the lowest course (earliest in the trace on
-//! a tie). Every piece still joins an earlier one by construction; the
-//! caller verifies the result (placeability included) and keeps the
-//! original order if it fails.
+//! at each turn it adds, among the pieces on the ground or stud-connected
+//! to what is already built, the one on the lowest course (earliest in the
+//! trace on a tie). So the bottom course is laid first, as on a table, and
+//! separate parts (the legs of an animal) rise side by side until the
+//! courses above join them. Every piece still joins an earlier one or the
+//! ground by construction; the caller verifies the result (placeability
+//! included) and keeps the original order if it fails.
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -64,6 +66,15 @@ pub fn by_course(assembly: &Assembly) -> Assembly {
     let mut heap: BinaryHeap<Reverse<(i32, usize)>> = BinaryHeap::new();
     let mut order: Vec<usize> = Vec::with_capacity(n);
     let mut next_seed = 0;
+    // Everything on the ground can start at once: a person lays the bottom
+    // course on the table before building on it.
+    let ground = bodies.iter().map(|b| b.bbox.min.z).min().unwrap_or(0);
+    for (i, b) in bodies.iter().enumerate() {
+        if b.bbox.min.z == ground {
+            queued[i] = true;
+            heap.push(Reverse((course(i), i)));
+        }
+    }
     while order.len() < n {
         if heap.is_empty() {
             // A new start: the lowest, earliest piece not yet placed (the
@@ -122,10 +133,9 @@ mod tests {
         let b = by_course(&a);
         assert!(verify(&b, None).is_ok(), "{}", verify(&b, None));
         let courses: Vec<i32> = b.pieces.iter().map(|p| p.placement.origin.z).collect();
-        // The two bottom courses join only through each other, so they
-        // alternate (a person would lay the bottom course on a baseplate);
-        // the third course comes after them, all in one run.
-        assert_eq!(courses, [0, 1, 0, 1, 0, 1, 0, 1, 2, 2, 2, 2]);
+        // The bottom course is laid on the table first, then each course
+        // in one run.
+        assert_eq!(courses, [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2]);
         let mut sorted = b.pieces.iter().map(|p| p.placement).collect::<Vec<_>>();
         sorted.sort_by_key(|p| (p.origin.z, p.origin.x));
         let mut orig = order.clone();

@@ -19,8 +19,10 @@
 //!   rests on A's top and some of A's studs (a slope has studs on its back
 //!   row only) meet B's underside where it takes studs (an inverted slope
 //!   only under its back row), or the reverse. Every piece after the first must be connected to
-//!   at least one *earlier* piece ([`Failure::NotConnected`]), and the whole
-//!   connection graph must be one component ([`Failure::Disconnected`]).
+//!   at least one *earlier* piece or stand on the ground, the build's lowest
+//!   layer, as a person starts another part of the model on the table
+//!   ([`Failure::NotConnected`]); and the finished build's connection graph
+//!   must be one component ([`Failure::Disconnected`]).
 //! - **Cover**: given a target voxel grid, the union of the cells the pieces
 //!   fill equals its filled cells exactly ([`Failure::CoverMismatch`]).
 //! - **Placeable at its turn** ([`Failure::NotPlaceable`]): let `O` be the
@@ -77,7 +79,8 @@ pub enum Failure {
         /// A cell both fill.
         cell: Cell,
     },
-    /// The piece is stud-connected to no earlier piece.
+    /// The piece is stud-connected to no earlier piece and does not stand
+    /// on the ground.
     NotConnected {
         /// The piece.
         piece: usize,
@@ -116,7 +119,7 @@ impl fmt::Display for Failure {
             }
             Failure::NotConnected { piece, step } => write!(
                 f,
-                "piece #{piece} (step {}) is not stud-connected to any earlier piece",
+                "piece #{piece} (step {}) is not stud-connected to any earlier piece, nor on the ground",
                 step.0
             ),
             Failure::NotPlaceable { piece, step } => write!(
@@ -190,8 +193,9 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
 
     let neighbours = connections(&bodies);
     let mut occupied = Occupied::default();
+    let ground = boxes.iter().map(|b| b.min.z).min().unwrap_or(0);
     for (i, b) in boxes.iter().enumerate() {
-        if i > 0 && !neighbours[i].iter().any(|&j| j < i) {
+        if i > 0 && b.min.z != ground && !neighbours[i].iter().any(|&j| j < i) {
             failures.push(Failure::NotConnected {
                 piece: i,
                 step: steps[i],

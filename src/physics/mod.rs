@@ -108,6 +108,7 @@
 
 mod model;
 mod steps;
+pub mod repair;
 
 use serde::Serialize;
 

@@ -196,5 +196,7 @@ pub fn stress_image(
         .iter()
         .map(|p| render::stress_color(if p.falls { f64::INFINITY } else { p.usage }))
         .collect();
-    render::model_image_with_colors(assembly, &colors, &options())
+    let mut img = render::model_image_with_colors(assembly, &colors, &options())?;
+    render::draw_stress_legend(&mut img);
+    Ok(img)
 }

@@ -19,8 +19,8 @@ use serde::Serialize;
 
 use crate::assembly::verify::verify;
 use crate::assembly::Assembly;
-use crate::physics::repair::{reorder, Moved};
-use crate::physics::{analyze_steps, Analysis, Params, PhysicsError, StepsAnalysis};
+use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
+use crate::physics::{analyze, analyze_steps, Analysis, Ground, Params, PhysicsError, StepsAnalysis};
 use crate::search::SearchOutcome;
 
 /// What the stability stage does.
@@ -127,6 +127,9 @@ pub struct StabilityReport {
     pub reseeded: Option<u64>,
     /// How the build stood before repairs, when it was repaired.
     pub before: Option<Before>,
+    /// When the build still fails on a table: whether it would stand at
+    /// every step on a baseplate (which holds the bottom course's studs).
+    pub stands_on_baseplate: Option<bool>,
     /// Force analyses solved, and reused from the step before.
     pub solves: usize,
     /// Analyses reused.
@@ -146,78 +149,174 @@ pub fn settle(
     params: &Params,
     replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
-    let mut plan = plan;
-    let mut check = analyze_steps(&plan.1, params, false)?;
-    let mut repairs = Vec::new();
-    let mut moved = Vec::new();
+    let mut counts = Counts::default();
+    let first = attempt(plan, params, mode == Stability::Repair, &mut counts)?;
+    let before = Before {
+        first_failure: first.check.first_failure,
+        min_score: first.check.last.min_score,
+        final_stands: first.check.last.stands(),
+    };
+    let mut best = first;
     let mut reseeded = None;
-    let mut before = None;
-    let mut solves = check.solves;
-    let mut reused = check.reused;
-    if mode == Stability::Repair && check.first_failure.is_some() {
-        before = Some(Before {
-            first_failure: check.first_failure,
-            min_score: check.last.min_score,
-            final_stands: check.last.stands(),
-        });
-        if !check.last.stands() {
-            let weak = check.last.pieces.iter().filter(|p| p.fails()).count();
-            for k in 1..=RESEEDS {
-                let other = seed.wrapping_add(k);
-                let candidate = replan(other)?;
-                let c = analyze_steps(&candidate.1, params, false)?;
-                solves += c.solves;
-                reused += c.reused;
-                if c.last.stands() {
-                    repairs.push(format!(
-                        "layout: {weak} pieces of the finished model would break off or fall; the search tried another layout (seed {other}) whose finished model stands (lowest score {:.2} -> {:.2})",
-                        check.last.min_score, c.last.min_score
-                    ));
-                    plan = candidate;
-                    check = c;
-                    reseeded = Some(other);
-                    break;
-                }
+    if mode == Stability::Repair && best.check.first_failure.is_some() {
+        // Other layouts of the same voxels; the first that stands at every
+        // step (after its own order repair) is kept, else the best tried.
+        for k in 1..=RESEEDS {
+            let other = seed.wrapping_add(k);
+            let planned = replan(other)?;
+            // The finished model first: one analysis rules most layouts out.
+            let last = analyze(&planned.1, params)?;
+            counts.solves += 1;
+            if !last.stands()
+                && (best.check.last.stands() || last.min_score <= best.check.last.min_score)
+            {
+                continue;
             }
-            if reseeded.is_none() {
-                repairs.push(format!(
-                    "layout: {weak} pieces of the finished model would break off or fall, and none of {RESEEDS} other layouts stood; the weak spots are listed"
-                ));
+            let candidate = attempt(planned, params, true, &mut counts)?;
+            if candidate.better_than(&best) {
+                best = candidate;
+                reseeded = Some(other);
             }
-        }
-        if let (true, Some(step)) = (check.last.stands(), check.first_failure) {
-            if let Some(r) = reorder(&plan.1, params, step)? {
-                solves += r.solves;
-                if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
-                    let c = analyze_steps(&r.assembly, params, false)?;
-                    solves += c.solves;
-                    reused += c.reused;
-                    if later(c.first_failure, check.first_failure) {
-                        repairs.push(format!(
-                            "order: step {step} would not stand; {} pieces were moved to later steps, where the structure holds them{}",
-                            r.moved.len(),
-                            match c.first_failure {
-                                None => ", and every step stands".to_string(),
-                                Some(s) => format!(", but step {s} still fails"),
-                            }
-                        ));
-                        moved = r.moved;
-                        plan.1 = r.assembly;
-                        check = c;
-                    }
-                }
-            }
-            if moved.is_empty() {
-                repairs.push(format!(
-                    "order: step {step} would not stand, and no order that defers its weak pieces did better"
-                ));
+            if best.check.first_failure.is_none() {
+                break;
             }
         }
     }
-    let report = report(
-        mode, params, &plan.1, &check, repairs, moved, reseeded, before, solves, reused,
+    let mut repairs = Vec::new();
+    if mode == Stability::Repair && before.first_failure.is_some() {
+        if let Some(other) = reseeded {
+            repairs.push(format!(
+                "layout: the search tried other layouts of the same voxels and kept seed {other}'s ({})",
+                if best.check.first_failure.is_none() {
+                    "it stands at every step"
+                } else {
+                    "it fails later or less"
+                }
+            ));
+        } else {
+            repairs.push(format!(
+                "layout: none of {RESEEDS} other layouts of the same voxels did better"
+            ));
+        }
+        match (&best.order_fix, best.order_tried) {
+            (Some(moved), _) => repairs.push(format!(
+                "order: {} pieces moved to later steps, where the structure holds them",
+                moved.len()
+            )),
+            (None, Some(step)) => repairs.push(format!(
+                "order: step {step} would not stand, and deferring its weak pieces (at most {MAX_REPAIRED_STEP} pieces a step) did not help"
+            )),
+            (None, None) => {}
+        }
+    }
+    let mut on_baseplate = None;
+    if best.check.first_failure.is_some() && params.ground == Ground::Table {
+        // What a person can still do: build on a baseplate, whose studs
+        // hold the bottom course.
+        let base = Params {
+            ground: Ground::Baseplate,
+            ..*params
+        };
+        let c = analyze_steps(&best.plan.1, &base, true)?;
+        counts.add(&c);
+        on_baseplate = Some(c.first_failure.is_none());
+    }
+    let Attempt {
+        plan,
+        check,
+        order_fix,
+        ..
+    } = best;
+    let repaired = mode == Stability::Repair && before.first_failure.is_some();
+    let mut report = report(
+        mode,
+        params,
+        &plan.1,
+        &check,
+        repairs,
+        order_fix.unwrap_or_default(),
+        reseeded,
+        repaired.then_some(before),
+        counts.solves,
+        counts.reused,
     );
+    report.stands_on_baseplate = on_baseplate;
     Ok((plan, report, check.last))
+}
+
+/// Analyses run, and results reused.
+#[derive(Default)]
+struct Counts {
+    solves: usize,
+    reused: usize,
+}
+
+impl Counts {
+    fn add(&mut self, c: &StepsAnalysis) {
+        self.solves += c.solves;
+        self.reused += c.reused;
+    }
+}
+
+/// One layout, checked and, when `repair`, its order repaired.
+struct Attempt {
+    plan: Plan,
+    check: StepsAnalysis,
+    /// The pieces the order repair moved, when it was kept.
+    order_fix: Option<Vec<Moved>>,
+    /// The step the order repair tried and could not fix.
+    order_tried: Option<u32>,
+}
+
+impl Attempt {
+    /// Stands at more steps: the finished model first, then a later first
+    /// failure, then a higher lowest score.
+    fn better_than(&self, other: &Attempt) -> bool {
+        let key = |a: &Attempt| {
+            (
+                a.check.last.stands(),
+                a.check.first_failure.map_or(u32::MAX, |s| s),
+                a.check.last.min_score,
+            )
+        };
+        key(self).partial_cmp(&key(other)) == Some(std::cmp::Ordering::Greater)
+    }
+}
+
+/// Checks every step of `plan` and, when `repair` and only the steps
+/// before the end fail, tries the order repair on it.
+fn attempt(
+    plan: Plan,
+    params: &Params,
+    repair: bool,
+    counts: &mut Counts,
+) -> Result<Attempt, crate::pipeline::BuildError> {
+    let mut plan = plan;
+    let mut check = analyze_steps(&plan.1, params, false)?;
+    counts.add(&check);
+    let mut order_fix = None;
+    let mut order_tried = None;
+    if let (true, true, Some(step)) = (repair, check.last.stands(), check.first_failure) {
+        order_tried = Some(step);
+        if let Some(r) = reorder(&plan.1, params, step)? {
+            counts.solves += r.solves;
+            if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
+                let c = analyze_steps(&r.assembly, params, false)?;
+                counts.add(&c);
+                if later(c.first_failure, check.first_failure) {
+                    order_fix = Some(r.moved);
+                    plan.1 = r.assembly;
+                    check = c;
+                }
+            }
+        }
+    }
+    Ok(Attempt {
+        plan,
+        check,
+        order_fix,
+        order_tried,
+    })
 }
 
 /// `a` fails later than `b` (`None`: never).
@@ -268,6 +367,7 @@ fn report(
         moved,
         reseeded,
         before,
+        stands_on_baseplate: None,
         solves,
         reused,
     }

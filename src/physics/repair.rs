@@ -1,0 +1,271 @@
+//! Repairing a build order so that every intermediate structure stands.
+//!
+//! A finished model can stand while one of its intermediate structures
+//! does not: an overhang put on before the piece that ties it back, a
+//! bridge arm long before its keystone. [`reorder`] walks the build step
+//! by step from the first step that fails and **defers** the pieces that
+//! would break off or fall: they wait, in their original order, and are
+//! offered again with every later step until the structure holds them.
+//! A deferred piece takes with it every piece that can only connect
+//! through it, so each step still joins what is built (the rewriting
+//! system's guarantee). Each candidate step is checked with the full
+//! force analysis ([`analyze`]); nothing is accepted on a guess.
+//!
+//! The caller verifies the new order (connection and placeability) and
+//! checks every step again with [`analyze_steps`](super::analyze_steps).
+
+use std::collections::BTreeSet;
+
+use serde::Serialize;
+
+use super::{analyze, Analysis, Params, PhysicsError};
+use crate::assembly::{Assembly, Placed, Step};
+
+/// A piece the repair moved to a later step.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Moved {
+    /// The piece's index in the original assembly.
+    pub piece: usize,
+    /// Its LDraw part.
+    pub part: &'static str,
+    /// Its step before the repair.
+    pub from_step: u32,
+    /// Its step after the repair.
+    pub to_step: u32,
+}
+
+/// What [`reorder`] did.
+#[derive(Debug, Clone)]
+pub struct Reordered {
+    /// The same pieces in the new order, steps renumbered.
+    pub assembly: Assembly,
+    /// The pieces that moved to a later step, in the original order.
+    pub moved: Vec<Moved>,
+    /// Force analyses run.
+    pub solves: usize,
+}
+
+/// Analyses a reorder may run, per step of the build, at most; a build
+/// that needs more is left as it is.
+const SOLVES_PER_STEP: usize = 4;
+
+/// Pieces a repaired step may hold at most: deferring more into one step
+/// would make a step no person can follow, so the reorder gives up.
+pub const MAX_REPAIRED_STEP: usize = 3 * crate::assembly::STEP_PIECES;
+
+/// Re-sequences `assembly`, whose steps before `first_failure` stand, so
+/// that the pieces which break off or fall are added only once the
+/// structure holds them. `None` when nothing could be moved, or when the
+/// structure would hold them only in a step of more than
+/// [`MAX_REPAIRED_STEP`] pieces.
+pub fn reorder(
+    assembly: &Assembly,
+    params: &Params,
+    first_failure: u32,
+) -> Result<Option<Reordered>, PhysicsError> {
+    let n = assembly.pieces.len();
+    let bodies: Vec<_> = assembly
+        .pieces
+        .iter()
+        .map(|p| p.placement.body(assembly.layer_ldu))
+        .collect();
+    let neighbours = crate::assembly::verify::connections(&bodies);
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, p) in assembly.pieces.iter().enumerate() {
+        match groups.last_mut() {
+            Some(g) if assembly.pieces[g[0]].step == p.step => g.push(i),
+            _ => groups.push(vec![i]),
+        }
+    }
+    let budget = SOLVES_PER_STEP * groups.len();
+    let mut placed: Vec<usize> = Vec::with_capacity(n);
+    let mut is_placed = vec![false; n];
+    let mut steps: Vec<Vec<usize>> = Vec::new();
+    let mut deferred: BTreeSet<usize> = BTreeSet::new();
+    let mut was_deferred = vec![false; n];
+    let mut solves = 0;
+    for group in groups {
+        let step = assembly.pieces[group[0]].step.0;
+        if step < first_failure {
+            for &i in &group {
+                placed.push(i);
+                is_placed[i] = true;
+            }
+            steps.push(group);
+            continue;
+        }
+        let mut trial: BTreeSet<usize> = deferred.iter().copied().chain(group).collect();
+        let mut held: BTreeSet<usize> = BTreeSet::new();
+        loop {
+            let mut kept = connected(&trial, &is_placed, &neighbours, placed.is_empty());
+            if kept.is_empty() {
+                break;
+            }
+            // The step's own pieces first, then those it now holds.
+            kept.sort_by_key(|&i| (was_deferred[i], i));
+            if solves >= budget {
+                return Ok(None);
+            }
+            solves += 1;
+            let analysis = analyze(&subset(assembly, &placed, &kept), params)?;
+            let failing = failing_new(&analysis, &placed, &kept, &neighbours);
+            if failing.is_empty() {
+                if kept.len() > MAX_REPAIRED_STEP {
+                    return Ok(None);
+                }
+                for &i in &kept {
+                    placed.push(i);
+                    is_placed[i] = true;
+                    trial.remove(&i);
+                }
+                steps.push(kept);
+                break;
+            }
+            for i in failing {
+                trial.remove(&i);
+                held.insert(i);
+            }
+        }
+        trial.extend(held);
+        for &i in &trial {
+            was_deferred[i] = true;
+        }
+        deferred = trial;
+    }
+    if !deferred.is_empty() {
+        // Whatever never stood is added at the end, as it was: the final
+        // check reports it.
+        let mut rest: Vec<usize> = deferred.into_iter().collect();
+        while !rest.is_empty() {
+            let set: BTreeSet<usize> = rest.iter().copied().collect();
+            let kept = connected(&set, &is_placed, &neighbours, placed.is_empty());
+            if kept.is_empty() {
+                // Cannot happen for a verified build: every piece joins the
+                // one structure. Keep the pieces rather than lose them.
+                steps.push(std::mem::take(&mut rest));
+                break;
+            }
+            if kept.len() > MAX_REPAIRED_STEP {
+                return Ok(None);
+            }
+            for &i in &kept {
+                placed.push(i);
+                is_placed[i] = true;
+            }
+            rest.retain(|i| !is_placed[*i]);
+            steps.push(kept);
+        }
+    }
+    let mut moved = Vec::new();
+    let mut pieces: Vec<Placed> = Vec::with_capacity(n);
+    for (s, group) in steps.iter().enumerate() {
+        let to = s as u32 + 1;
+        for &i in group {
+            let p = assembly.pieces[i];
+            if was_deferred[i] {
+                moved.push(Moved {
+                    piece: i,
+                    part: p.placement.part.spec().id.0,
+                    from_step: p.step.0,
+                    to_step: to,
+                });
+            }
+            pieces.push(Placed { step: Step(to), ..p });
+        }
+    }
+    if moved.is_empty() {
+        return Ok(None);
+    }
+    moved.sort_by_key(|m| m.piece);
+    Ok(Some(Reordered {
+        assembly: Assembly {
+            pieces,
+            layer_ldu: assembly.layer_ldu,
+        },
+        moved,
+        solves,
+    }))
+}
+
+/// The pieces of `trial` that join what is built, in order: each connects
+/// to a placed piece or to one kept before it (the first piece of an
+/// empty build needs nothing). Pieces that only connect through a later
+/// one are found by repeating the pass.
+fn connected(
+    trial: &BTreeSet<usize>,
+    is_placed: &[bool],
+    neighbours: &[Vec<usize>],
+    empty: bool,
+) -> Vec<usize> {
+    let mut kept: Vec<usize> = Vec::new();
+    let mut in_kept = BTreeSet::new();
+    loop {
+        let before = kept.len();
+        for &i in trial {
+            if in_kept.contains(&i) {
+                continue;
+            }
+            let joins = (empty && kept.is_empty())
+                || neighbours[i]
+                    .iter()
+                    .any(|&j| is_placed[j] || in_kept.contains(&j));
+            if joins {
+                kept.push(i);
+                in_kept.insert(i);
+            }
+        }
+        if kept.len() == before {
+            return kept;
+        }
+    }
+}
+
+/// The placed pieces, then the kept ones, as one assembly to analyse.
+fn subset(assembly: &Assembly, placed: &[usize], kept: &[usize]) -> Assembly {
+    Assembly {
+        pieces: placed
+            .iter()
+            .chain(kept)
+            .map(|&i| assembly.pieces[i])
+            .collect(),
+        layer_ldu: assembly.layer_ldu,
+    }
+}
+
+/// The new pieces to defer after `analysis` of placed ++ kept failed:
+/// the new pieces that break off or fall; when only built pieces fail
+/// (the new load broke them), the new pieces touching a failing one, or
+/// else all new pieces. Empty when the structure stands.
+fn failing_new(
+    analysis: &Analysis,
+    placed: &[usize],
+    kept: &[usize],
+    neighbours: &[Vec<usize>],
+) -> Vec<usize> {
+    let fails = |k: usize| {
+        let p = &analysis.pieces[k];
+        p.fails()
+    };
+    let n_old = placed.len();
+    let new: Vec<usize> = (0..kept.len())
+        .filter(|&k| fails(n_old + k))
+        .map(|k| kept[k])
+        .collect();
+    if !new.is_empty() {
+        return new;
+    }
+    let old: BTreeSet<usize> = (0..n_old).filter(|&k| fails(k)).map(|k| placed[k]).collect();
+    if old.is_empty() {
+        return Vec::new();
+    }
+    let touching: Vec<usize> = kept
+        .iter()
+        .copied()
+        .filter(|&i| neighbours[i].iter().any(|j| old.contains(j)))
+        .collect();
+    if touching.is_empty() {
+        kept.to_vec()
+    } else {
+        touching
+    }
+}

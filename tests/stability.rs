@@ -1,0 +1,237 @@
+//! The build's stability stage end to end: `--stability check` refuses a
+//! build that would tip over, the default repair reports it (and writes the
+//! stress picture), a model that stands says so, and the order repair
+//! builds a counterweight before the overhang it holds.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use brickwright::assembly::verify::verify;
+use brickwright::assembly::{Assembly, Placed, Placement, Step};
+use brickwright::catalog::{Color, PartKind};
+use brickwright::geom::{Cell, Rot};
+use brickwright::physics::repair::reorder;
+use brickwright::physics::{analyze_steps, Params};
+use serde_json::Value;
+
+/// A gallows: a post one stud square and four bricks high, and an arm
+/// seven studs long on top, all one stud deep. On a table the post tips
+/// over as soon as the arm is on (the arm's weight is far past the post's
+/// one-stud base); on a baseplate the post's stud holds it.
+fn write_gallows(dir: &Path) -> PathBuf {
+    let profile = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (1.0, 4.8),
+        (7.0, 4.8),
+        (7.0, 6.0),
+        (0.0, 6.0),
+    ];
+    let mut obj = String::new();
+    for z in [0.0, 1.0] {
+        for (x, y) in profile {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    let n = profile.len();
+    // The L-shaped caps, in four triangles each, then the sides.
+    for (a, b, c) in [(0, 1, 2), (0, 2, 5), (2, 3, 4), (2, 4, 5)] {
+        obj += &format!("f {} {} {}\n", a + 1, c + 1, b + 1);
+        obj += &format!("f {} {} {}\n", a + n + 1, b + n + 1, c + n + 1);
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        obj += &format!("f {} {} {}\n", i + 1, j + 1, j + n + 1);
+        obj += &format!("f {} {} {}\n", i + 1, j + n + 1, i + n + 1);
+    }
+    let path = dir.join("gallows.obj");
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+fn brickwright(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_brickwright"))
+        .args(args)
+        .output()
+        .expect("cannot start the brickwright binary")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn report(out: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn check_refuses_a_build_that_tips_over_with_one_line_and_no_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = write_gallows(tmp.path());
+    let out = tmp.path().join("out");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "7",
+        "-o",
+        s(&out),
+        "--stability",
+        "check",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("gallows.obj: at step "),
+        "{stderr}"
+    );
+    // It names the arm that tips the post, with its step.
+    assert!(stderr.contains("3009 Brick 1 x 6"), "{stderr}");
+    assert!(!out.exists(), "no files on failure");
+}
+
+#[test]
+fn repair_reports_what_it_could_not_fix_and_draws_the_stress() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = write_gallows(tmp.path());
+    let out = tmp.path().join("out");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "7",
+        "-o",
+        s(&out),
+        "--formats",
+        "ldr,stress",
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    assert!(stdout.contains("warning: at step"), "{stdout}");
+    assert!(stdout.contains("baseplate"), "{stdout}");
+    let r = report(&out);
+    let st = &r["stability"];
+    assert_eq!(st["mode"], "repair", "{st}");
+    assert_eq!(st["stands"], false, "{st}");
+    assert_eq!(st["stands_on_baseplate"], true, "{st}");
+    assert!(st["first_failure"].as_u64().is_some(), "{st}");
+    assert!(!st["repairs"].as_array().unwrap().is_empty(), "{st}");
+    let weakest = st["weakest"].as_array().unwrap();
+    assert!(weakest.iter().any(|w| w["falls"] == true), "{st}");
+    assert_eq!(
+        st["steps"].as_array().unwrap().len() as u64,
+        r["steps"].as_u64().unwrap()
+    );
+    // The stress picture has the falling pieces in red.
+    let img = image::open(out.join("gallows-stress.png")).unwrap().to_rgba8();
+    let red = img
+        .pixels()
+        .filter(|p| p[0] > 150 && p[1] < 60 && p[2] < 60 && p[3] == 255)
+        .count();
+    assert!(red > 500, "{red} red pixels");
+}
+
+#[test]
+fn a_model_that_stands_says_so_and_stress_needs_the_check() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
+    let out = tmp.path().join("out");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "10",
+        "-o",
+        s(&out),
+        "--formats",
+        "ldr,stress",
+        "-q",
+    ]);
+    assert!(run.status.success());
+    let st = report(&out)["stability"].clone();
+    assert_eq!(st["stands"], true, "{st}");
+    assert!(st["first_failure"].is_null(), "{st}");
+    let min = st["min_score"].as_f64().unwrap();
+    let mean = st["mean_score"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&min) && min <= mean && mean <= 1.0, "{st}");
+    assert!(out.join("house-stress.png").is_file());
+    let ldr = out.join("house.ldr");
+    let verified = brickwright(&["verify", "--stability", s(&ldr)]);
+    assert!(
+        verified.status.success(),
+        "{}",
+        String::from_utf8_lossy(&verified.stdout)
+    );
+
+    // Off: no section, and naming the stress picture is an error.
+    let off = tmp.path().join("off");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "10",
+        "-o",
+        s(&off),
+        "--formats",
+        "ldr",
+        "--stability",
+        "off",
+        "-q",
+    ]);
+    assert!(run.status.success());
+    assert!(report(&off)["stability"].is_null());
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "-o",
+        s(&off),
+        "--formats",
+        "stress",
+        "--stability",
+        "off",
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--formats stress"));
+}
+
+/// A 1x4 base on the table, a 1x6 overhang clutched to its last stud, and
+/// a 1x2 counterweight on its other end: built overhang first, the base
+/// tips at step 2 (the known answer of tests/physics.rs).
+fn overhang_first() -> Assembly {
+    let piece = |id: &str, x: i32, z: i32, step: u32| Placed {
+        placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0),
+        step: Step(step),
+        color: Color::RED,
+    };
+    Assembly {
+        pieces: vec![
+            piece("3010", 0, 0, 1),
+            piece("3009", 3, 1, 2),
+            piece("3004", 0, 1, 3),
+        ],
+        layer_ldu: 24,
+    }
+}
+
+#[test]
+fn the_order_repair_puts_the_counterweight_before_the_overhang() {
+    let params = Params::default();
+    let wrong = overhang_first();
+    let check = analyze_steps(&wrong, &params, false).unwrap();
+    assert_eq!(check.first_failure, Some(2));
+    let fixed = reorder(&wrong, &params, 2).unwrap().expect("a better order");
+    let parts: Vec<&str> = fixed
+        .assembly
+        .pieces
+        .iter()
+        .map(|p| p.placement.part.spec().id.0)
+        .collect();
+    assert_eq!(parts, ["3010", "3004", "3009"]);
+    assert_eq!(fixed.moved.len(), 1);
+    assert_eq!(fixed.moved[0].part, "3009");
+    assert_eq!(fixed.moved[0].from_step, 2);
+    assert!(verify(&fixed.assembly, None).is_ok());
+    let again = analyze_steps(&fixed.assembly, &params, false).unwrap();
+    assert_eq!(again.first_failure, None, "{again:?}");
+}
