@@ -21,7 +21,8 @@
 //!    its pieces ([`shown`]).
 //! 3. **Hysteresis** ([`choose`]). The views of all steps are chosen
 //!    together, at least cost: a step costs how far its score falls short
-//!    of [`KEEP`], and every change of view costs [`SWITCH`]. So a view
+//!    of [`KEEP`], every change of view costs [`SWITCH`], and each step
+//!    seen turned a little, [`AWAY`]. So a view
 //!    turns only for steps it hides badly, stays put within a run of
 //!    steps, a turned view is kept while it still shows the new pieces
 //!    (rather than flipping back and forth), the one view that shows a
@@ -64,6 +65,11 @@ pub const KEEP: f32 = 0.75;
 /// for one hidden step and back only when that step is mostly hidden, and
 /// stays turned as long as it shows the steps well enough.
 pub const SWITCH: f32 = 0.45;
+/// The extra cost of a step seen from a turned view: a turned view that
+/// shows the steps is kept for a while, but not for the rest of the
+/// book when the base view would do (it returns home once that saves
+/// more than [`SWITCH`]).
+pub const AWAY: f32 = 0.02;
 /// Costs closer than this are equal.
 const TIE: f32 = 1e-5;
 /// Pieces covering fewer probe samples than this count as shown (too
@@ -174,10 +180,10 @@ fn shown_in(
 /// The quarter turns (0 to 3) from the base view of each step's view,
 /// given how well each view shows each step (see [`shown`]): the choice
 /// of least cost, where a step costs how far its view falls short of
-/// [`KEEP`] (1 for a step it hides, 0 for one it shows) and every change
-/// of view costs [`SWITCH`]. Among equal choices a view changes as late
-/// as it can (a turned view is kept while it shows the steps), and the
-/// last step's view is the lowest turn. Found exactly by dynamic
+/// [`KEEP`] (1 for a step it hides, 0 for one it shows), every change
+/// of view costs [`SWITCH`], and a step seen from a turned view costs
+/// [`AWAY`] more. Among equal choices a view changes as late as it can,
+/// and the last step's view is the lowest turn. Found exactly by dynamic
 /// programming over the steps, four views a step.
 pub(crate) fn choose(shown: &[[f32; 4]]) -> Vec<u8> {
     let miss = |f: f32| (KEEP - f).max(0.0) / KEEP;
@@ -196,7 +202,7 @@ pub(crate) fn choose(shown: &[[f32; 4]]) -> Vec<u8> {
                     (best, at) = (c, u);
                 }
             }
-            next[k] = best + miss(f[k]);
+            next[k] = best + miss(f[k]) + if k == 0 { 0.0 } else { AWAY };
             back[k] = at as u8;
         }
         from.push(back);
@@ -227,9 +233,16 @@ mod tests {
     fn a_hidden_step_turns_and_the_turned_view_is_kept_while_it_shows() {
         let f = [ALL, [0.0, 0.3, 1.0, 0.3], ALL, ALL];
         assert_eq!(choose(&f), [0, 2, 2, 2]);
-        // Back home when the turned view hides a step.
+        // When the turned view hides a later step, back home as soon as
+        // the base view shows the steps again.
         let f = [ALL, [0.0, 0.3, 1.0, 0.3], ALL, [1.0, 0.3, 0.0, 0.3]];
-        assert_eq!(choose(&f), [0, 2, 2, 0]);
+        assert_eq!(choose(&f), [0, 2, 0, 0]);
+        // And after a long run that the base view would show as well.
+        let mut f = vec![ALL, [0.0, 0.3, 1.0, 0.3]];
+        f.extend([ALL; 40]);
+        let turns = choose(&f);
+        assert_eq!(turns[1], 2);
+        assert_eq!(turns[2], 0);
     }
 
     #[test]
