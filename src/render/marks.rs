@@ -293,7 +293,7 @@ mod tests {
     fn blend_over_opaque_and_transparent() {
         let mut px = Rgba([255, 255, 255, 255]);
         blend(&mut px, [0, 0, 0], 8, 16);
-        assert_eq!(px.0, [128, 128, 128, 255]);
+        assert_eq!(px.0, [127, 127, 127, 255]);
         let mut px = Rgba([255, 255, 255, 0]);
         blend(&mut px, [10, 20, 30], 16, 16);
         assert_eq!(px.0, [10, 20, 30, 255]);

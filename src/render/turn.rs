@@ -19,13 +19,15 @@
 //!    once [`PIECE_SHOWN`] of it is seen (the top of a brick among its
 //!    neighbours is enough), and a step's score in a view is the mean over
 //!    its pieces ([`shown`]).
-//! 3. **Hysteresis** ([`choose`]). The view stays as it is while it
-//!    shows [`KEEP`] of the step. Otherwise it turns to the view that
-//!    shows at least [`GAIN`] more, preferring the one that also shows the
-//!    next step well, and the base view among near equals. So the view
-//!    stays put within a run of steps, a turned view is kept while it
-//!    still shows the new pieces, and a model built where it can be seen
-//!    never turns.
+//! 3. **Hysteresis** ([`choose`]). The views of all steps are chosen
+//!    together, at least cost: a step costs how far its score falls short
+//!    of [`KEEP`], every change of view costs [`SWITCH`], and each step
+//!    seen turned a little, [`AWAY`]. So a view
+//!    turns only for steps it hides badly, stays put within a run of
+//!    steps, a turned view is kept while it still shows the new pieces
+//!    (rather than flipping back and forth), the one view that shows a
+//!    run of steps on both sides is found when there is one, and a model
+//!    built where it can be seen never turns.
 //!
 //! Everything is computed in a fixed order from the scene alone, so the
 //! choice, and the images, are the same on every run.
@@ -56,14 +58,20 @@ pub enum Turning {
 const PROBE_SIDE: f32 = 320.0;
 /// Share of a piece that must be seen for it to count as shown.
 pub const PIECE_SHOWN: f32 = 0.4;
-/// A view is kept while its score for the step is at least this.
+/// A view shows a step well enough when its score for the step is at
+/// least this; below, the step costs the shortfall (see [`choose`]).
 pub const KEEP: f32 = 0.75;
-/// How much higher another view must score for the view to turn to it.
-pub const GAIN: f32 = 0.25;
-/// Weight of the next step's score in choosing among better views.
-const LOOKAHEAD: f32 = 0.5;
-/// Head start of the base view in choosing among better views.
-const HOME: f32 = 0.1;
+/// The cost of changing the view, in steps the view hides: a view turns
+/// for one hidden step and back only when that step is mostly hidden, and
+/// stays turned as long as it shows the steps well enough.
+pub const SWITCH: f32 = 0.45;
+/// The extra cost of a step seen from a turned view: a turned view that
+/// shows the steps is kept for a while, but not for the rest of the
+/// book when the base view would do (it returns home once that saves
+/// more than [`SWITCH`]).
+pub const AWAY: f32 = 0.02;
+/// Costs closer than this are equal.
+const TIE: f32 = 1e-5;
 /// Pieces covering fewer probe samples than this count as shown (too
 /// small to judge).
 const MIN_SAMPLES: f32 = 4.0;
@@ -170,73 +178,86 @@ fn shown_in(
 }
 
 /// The quarter turns (0 to 3) from the base view of each step's view,
-/// given how well each view shows each step (see [`shown`] and the
-/// module docs).
+/// given how well each view shows each step (see [`shown`]): the choice
+/// of least cost, where a step costs how far its view falls short of
+/// [`KEEP`] (1 for a step it hides, 0 for one it shows), every change
+/// of view costs [`SWITCH`], and a step seen from a turned view costs
+/// [`AWAY`] more. Among equal choices a view changes as late as it can,
+/// and the last step's view is the lowest turn. Found exactly by dynamic
+/// programming over the steps, four views a step.
 pub(crate) fn choose(shown: &[[f32; 4]]) -> Vec<u8> {
-    let mut current = 0;
-    shown
-        .iter()
-        .enumerate()
-        .map(|(n, f)| {
-            if f[current] < KEEP {
-                let next = shown.get(n + 1);
-                let score = |k: usize| {
-                    f[k] + next.map_or(0.0, |g| LOOKAHEAD * g[k]) + if k == 0 { HOME } else { 0.0 }
-                };
-                let mut best: Option<usize> = None;
-                for k in 0..4 {
-                    let better = f[k] >= f[current] + GAIN;
-                    if k != current && better && best.is_none_or(|b| score(k) > score(b)) {
-                        best = Some(k);
-                    }
+    let miss = |f: f32| (KEEP - f).max(0.0) / KEEP;
+    // cost[k]: the least cost of the steps so far, ending in view k;
+    // from[n][k]: the view of step n - 1 on that best path.
+    let mut cost = [0.0, f32::INFINITY, f32::INFINITY, f32::INFINITY];
+    let mut from: Vec<[u8; 4]> = Vec::with_capacity(shown.len());
+    for f in shown {
+        let mut next = [0.0; 4];
+        let mut back = [0; 4];
+        for k in 0..4 {
+            let (mut best, mut at) = (f32::INFINITY, 0);
+            for (u, &c) in cost.iter().enumerate() {
+                let c = c + if u == k { 0.0 } else { SWITCH };
+                if c < best - TIE || (c <= best + TIE && u != k) {
+                    (best, at) = (c, u);
                 }
-                current = best.unwrap_or(current);
             }
-            current as u8
-        })
-        .collect()
+            next[k] = best + miss(f[k]) + if k == 0 { 0.0 } else { AWAY };
+            back[k] = at as u8;
+        }
+        from.push(back);
+        cost = next;
+    }
+    let mut k = (0..4).fold(0, |b, k| if cost[k] < cost[b] - TIE { k } else { b });
+    let mut turns = vec![0; shown.len()];
+    for n in (0..shown.len()).rev() {
+        turns[n] = k as u8;
+        k = usize::from(from[n][k]);
+    }
+    turns
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    const ALL: [f32; 4] = [1.0; 4];
+
     #[test]
     fn the_view_stays_while_it_shows_the_step() {
-        let f = [
-            [1.0, 1.0, 1.0, 1.0],
-            [0.8, 1.0, 1.0, 1.0],
-            [0.76, 0.2, 0.2, 0.2],
-        ];
+        let f = [ALL, [0.8, 1.0, 1.0, 1.0], [0.76, 0.2, 0.2, 0.2]];
         assert_eq!(choose(&f), [0, 0, 0]);
     }
 
     #[test]
-    fn a_hidden_step_turns_to_the_view_that_shows_it_and_stays_there() {
-        let f = [
-            [1.0, 1.0, 1.0, 1.0],
-            [0.1, 0.5, 1.0, 0.5],
-            // Seen from both; the turned view is kept.
-            [0.9, 0.9, 0.8, 0.9],
-            // The turned view hides this one: back to the base view.
-            [1.0, 0.7, 0.2, 0.7],
-        ];
-        assert_eq!(choose(&f), [0, 2, 2, 0]);
+    fn a_hidden_step_turns_and_the_turned_view_is_kept_while_it_shows() {
+        let f = [ALL, [0.0, 0.3, 1.0, 0.3], ALL, ALL];
+        assert_eq!(choose(&f), [0, 2, 2, 2]);
+        // When the turned view hides a later step, back home as soon as
+        // the base view shows the steps again.
+        let f = [ALL, [0.0, 0.3, 1.0, 0.3], ALL, [1.0, 0.3, 0.0, 0.3]];
+        assert_eq!(choose(&f), [0, 2, 0, 0]);
+        // And after a long run that the base view would show as well.
+        let mut f = vec![ALL, [0.0, 0.3, 1.0, 0.3]];
+        f.extend([ALL; 40]);
+        let turns = choose(&f);
+        assert_eq!(turns[1], 2);
+        assert_eq!(turns[2], 0);
     }
 
     #[test]
-    fn small_gains_and_hidden_everywhere_do_not_turn() {
-        let f = [[0.6, 0.8, 0.8, 0.8], [0.1, 0.2, 0.2, 0.2]];
-        assert_eq!(choose(&f), [0, 0]);
+    fn small_shortfalls_and_steps_hidden_everywhere_do_not_turn() {
+        assert_eq!(choose(&[ALL, [0.6, 1.0, 1.0, 1.0], ALL]), [0, 0, 0]);
+        assert_eq!(choose(&[ALL, [0.1, 0.2, 0.2, 0.2], ALL]), [0, 0, 0]);
     }
 
     #[test]
-    fn among_equals_the_base_view_and_then_the_next_step_decide() {
-        // From a turned view that hides the step, home wins a tie.
-        let f = [[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 1.0]];
-        assert_eq!(choose(&f), [2, 0]);
-        // The view that shows the next step too wins.
-        let f = [[0.2, 1.0, 0.2, 1.0], [0.2, 0.3, 0.2, 1.0]];
-        assert_eq!(choose(&f), [3, 3]);
+    fn a_view_that_shows_both_sides_beats_flipping() {
+        // Steps alternate between the front and the back; the side view
+        // shows both well enough.
+        let front = [1.0, 0.8, 0.0, 0.8];
+        let back = [0.0, 0.8, 1.0, 0.8];
+        let f = [back, front, back, front, back, front];
+        assert_eq!(choose(&f), [1; 6]);
     }
 }
