@@ -155,6 +155,7 @@ fn build_and_verify(name: &str) {
         ".png",
         "-exploded.png",
         ".pdf",
+        "-stress.png",
     ]
     .iter()
     .map(|suffix| match *suffix {
