@@ -81,10 +81,15 @@
 //!
 //! [`analyze_steps`] checks every intermediate build (the pieces of steps
 //! `1..=k`). It keeps a union-find of the groups as pieces are added; a
-//! group no piece of step `k` joined keeps its result from an earlier step,
-//! and only the groups that grew are solved, all steps' programs in
-//! parallel. (Clarabel is an interior-point solver with no warm start, so
-//! reuse is at the level of whole groups.)
+//! group no piece of step `k` joined keeps its result from an earlier step.
+//! A group that stood and grew only by pieces whose weight goes straight
+//! down to the ground in compression (each point under the centre of mass
+//! lies on a face of the piece below, down to the ground) needs no solve
+//! either: adding that compression to the old forces is an equilibrium
+//! with the same clutch usage, a certificate that it still stands. Only
+//! the remaining groups are solved, a step's groups in parallel. (Clarabel
+//! is an interior-point solver with no warm start; this certificate is the
+//! reuse of the previous solution.) The finished build is solved afresh.
 //!
 //! # Example
 //!
@@ -218,6 +223,16 @@ impl PieceStress {
         }
     }
 
+    /// A piece resting in compression only.
+    fn resting() -> PieceStress {
+        PieceStress {
+            usage: 0.0,
+            score: 1.0,
+            falls: false,
+            breaks: false,
+        }
+    }
+
     /// Whether it falls or breaks off.
     pub fn fails(&self) -> bool {
         self.falls || self.breaks
@@ -326,9 +341,11 @@ pub struct StepsAnalysis {
     pub last: Analysis,
     /// Wall-clock seconds for everything.
     pub seconds: f64,
-    /// Programs solved.
+    /// Programs solved (the finished build's groups count as one).
     pub solves: usize,
-    /// Groups whose result was carried over from an earlier step instead.
+    /// Groups whose result was carried over from the step before instead:
+    /// untouched, or grown only by pieces resting straight on the ground
+    /// through compression.
     pub reused: usize,
 }
 
