@@ -102,12 +102,13 @@
 //! let brick = PartKind::from_id("3001").unwrap();
 //! let order = [
 //!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
-//!     Placement::new(brick, Cell::new(2, 0, 1), Rot::R0),
+//!     Placement::new(brick, Cell::new(3, 0, 1), Rot::R0),
 //! ];
 //! let asm = Assembly::from_order(&order, 24, Color::RED);
 //! let a = analyze(&asm, &Params::default()).unwrap();
 //! assert!(a.stands());
-//! // The upper brick hangs half off: its clutch holds it.
+//! // The upper brick's centre is past the lower one's edge: its clutch
+//! // holds it.
 //! assert!(a.pieces[1].usage > 0.0 && a.pieces[1].usage < 1.0);
 //! ```
 
