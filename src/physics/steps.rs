@@ -137,7 +137,8 @@ pub(super) fn solve_all(
 /// Each step reuses what it can of the step before: a group of pieces the
 /// step did not touch keeps its result; a group that stood and gained
 /// only pieces whose weight goes straight down to the ground in
-/// compression ([`Structure::drops_straight`]) still stands with the same
+/// compression (each point under its centre of mass on a face of the piece
+/// below, down to the ground) still stands with the same
 /// clutch usage, the new pieces using none. Only the other groups are
 /// solved, in parallel. The finished build is solved afresh, so
 /// [`StepsAnalysis::last`] is what [`analyze`](super::analyze) gives (and
