@@ -6,6 +6,13 @@
 //! 1 s and of a 5,000-piece model in under 10 s; every step of the
 //! 1,000-piece build (grouped as `build` groups it) in under 10 s in all.
 //!
+//! Measured (2 cores, Clarabel with QDLDL): 1,024 pieces in 0.13 s, 5,040
+//! in 0.61 s, every step of the 1,024-piece build in 0.10 s (every step
+//! but the last is certified without a solve: each brick rests straight
+//! on the ones below). A real model is slower: the 756-piece bunny of
+//! `build --studs 32` takes 0.5 s whole and 42 s step by step, since most
+//! of its steps add pieces that need clutch and are solved one by one.
+//!
 //! ```text
 //! cargo bench --bench physics
 //! cargo bench --bench physics -- --warm-up-time 1 --measurement-time 5

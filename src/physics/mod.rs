@@ -81,10 +81,15 @@
 //!
 //! [`analyze_steps`] checks every intermediate build (the pieces of steps
 //! `1..=k`). It keeps a union-find of the groups as pieces are added; a
-//! group no piece of step `k` joined keeps its result from an earlier step,
-//! and only the groups that grew are solved, all steps' programs in
-//! parallel. (Clarabel is an interior-point solver with no warm start, so
-//! reuse is at the level of whole groups.)
+//! group no piece of step `k` joined keeps its result from an earlier step.
+//! A group that stood and grew only by pieces whose weight goes straight
+//! down to the ground in compression (each point under the centre of mass
+//! lies on a face of the piece below, down to the ground) needs no solve
+//! either: adding that compression to the old forces is an equilibrium
+//! with the same clutch usage, a certificate that it still stands. Only
+//! the remaining groups are solved, a step's groups in parallel. (Clarabel
+//! is an interior-point solver with no warm start; this certificate is the
+//! reuse of the previous solution.) The finished build is solved afresh.
 //!
 //! # Example
 //!
@@ -97,12 +102,13 @@
 //! let brick = PartKind::from_id("3001").unwrap();
 //! let order = [
 //!     Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
-//!     Placement::new(brick, Cell::new(2, 0, 1), Rot::R0),
+//!     Placement::new(brick, Cell::new(3, 0, 1), Rot::R0),
 //! ];
 //! let asm = Assembly::from_order(&order, 24, Color::RED);
 //! let a = analyze(&asm, &Params::default()).unwrap();
 //! assert!(a.stands());
-//! // The upper brick hangs half off: its clutch holds it.
+//! // The upper brick's centre is past the lower one's edge: its clutch
+//! // holds it.
 //! assert!(a.pieces[1].usage > 0.0 && a.pieces[1].usage < 1.0);
 //! ```
 
@@ -219,6 +225,16 @@ impl PieceStress {
         }
     }
 
+    /// A piece resting in compression only.
+    fn resting() -> PieceStress {
+        PieceStress {
+            usage: 0.0,
+            score: 1.0,
+            falls: false,
+            breaks: false,
+        }
+    }
+
     /// Whether it falls or breaks off.
     pub fn fails(&self) -> bool {
         self.falls || self.breaks
@@ -327,9 +343,11 @@ pub struct StepsAnalysis {
     pub last: Analysis,
     /// Wall-clock seconds for everything.
     pub seconds: f64,
-    /// Programs solved.
+    /// Programs solved (the finished build's groups count as one).
     pub solves: usize,
-    /// Groups whose result was carried over from an earlier step instead.
+    /// Groups whose result was carried over from the step before instead:
+    /// untouched, or grown only by pieces resting straight on the ground
+    /// through compression.
     pub reused: usize,
 }
 

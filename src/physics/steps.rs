@@ -49,8 +49,6 @@ impl Groups {
 
 /// One program to solve: a group of the build after some step.
 struct Job {
-    /// Index of the step (into the step list) it belongs to.
-    step: usize,
     /// The group's pieces, sorted.
     pieces: Vec<usize>,
     /// Indices into the structure's contacts.
@@ -66,7 +64,6 @@ fn jobs_for_step(
     g: &mut Groups,
     next_contact: &mut usize,
     end: usize,
-    step: usize,
     reused: &mut usize,
 ) -> Vec<Job> {
     let start = g.parent.len();
@@ -88,7 +85,6 @@ fn jobs_for_step(
     touched
         .into_iter()
         .map(|root| Job {
-            step,
             pieces: (0..end).filter(|&p| roots[p] == root).collect(),
             contacts: (0..c)
                 .filter(|&k| roots[s.contacts[k].below] == root)
@@ -123,7 +119,7 @@ pub(super) fn solve_all(
 ) -> Result<Vec<PieceStress>, PhysicsError> {
     let mut g = Groups::new();
     let (mut next, mut reused) = (0, 0);
-    let jobs = jobs_for_step(s, &mut g, &mut next, n, 0, &mut reused);
+    let jobs = jobs_for_step(s, &mut g, &mut next, n, &mut reused);
     let results = run(s, &jobs, params)?;
     let mut out = vec![PieceStress::falling(); n];
     for (job, r) in jobs.iter().zip(results) {
@@ -135,10 +131,18 @@ pub(super) fn solve_all(
 }
 
 /// Analyses every intermediate build (the pieces of steps `1..=k`, for
-/// each step `k`), solving only the groups of pieces a step changed, and
-/// finds the first step at which something falls or breaks off. With
-/// `stop_at_first_failure`, stops there (solving a few steps ahead in
-/// parallel).
+/// each step `k`) and finds the first step at which something falls or
+/// breaks off; with `stop_at_first_failure`, stops there.
+///
+/// Each step reuses what it can of the step before: a group of pieces the
+/// step did not touch keeps its result; a group that stood and gained
+/// only pieces whose weight goes straight down to the ground in
+/// compression (each point under its centre of mass on a face of the piece
+/// below, down to the ground) still stands with the same
+/// clutch usage, the new pieces using none. Only the other groups are
+/// solved, in parallel. The finished build is solved afresh, so
+/// [`StepsAnalysis::last`] is what [`analyze`](super::analyze) gives (and
+/// the last step's check agrees with it).
 pub fn analyze_steps(
     assembly: &Assembly,
     params: &Params,
@@ -155,63 +159,73 @@ pub fn analyze_steps(
             _ => bounds.push((p.step.0, i + 1)),
         }
     }
-    let chunk = if stop_at_first_failure {
-        2 * rayon::current_num_threads()
-    } else {
-        bounds.len().max(1)
-    };
     let mut g = Groups::new();
     let (mut next, mut reused, mut solves) = (0, 0, 0);
     let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
-    let mut end_checked = 0;
-    'chunks: for (c, chunk_bounds) in bounds.chunks(chunk).enumerate() {
-        let mut jobs = Vec::new();
-        for (k, &(_, end)) in chunk_bounds.iter().enumerate() {
-            jobs.extend(jobs_for_step(
-                &s,
-                &mut g,
-                &mut next,
-                end,
-                c * chunk + k,
-                &mut reused,
-            ));
-        }
-        solves += jobs.iter().filter(|j| j.grounded).count();
-        let results = run(&s, &jobs, params)?;
-        let mut at = 0;
-        for (k, &(step, end)) in chunk_bounds.iter().enumerate() {
-            while at < jobs.len() && jobs[at].step == c * chunk + k {
-                for (&p, &st) in jobs[at].pieces.iter().zip(&results[at]) {
-                    current[p] = st;
+    let mut begin = 0;
+    for &(step, end) in &bounds {
+        let jobs = jobs_for_step(&s, &mut g, &mut next, end, &mut reused);
+        let mut to_solve = Vec::new();
+        for job in jobs {
+            let stood = job
+                .pieces
+                .iter()
+                .all(|&p| p >= begin || !current[p].fails());
+            let certified = job.grounded
+                && stood
+                && job
+                    .pieces
+                    .iter()
+                    .all(|&p| p < begin || s.drops_straight(p, end));
+            if certified {
+                for &p in job.pieces.iter().filter(|&&p| p >= begin) {
+                    current[p] = PieceStress::resting();
                 }
-                at += 1;
-            }
-            let placed = &current[..end];
-            let stands = !placed.iter().any(PieceStress::fails);
-            steps.push(StepCheck {
-                step,
-                min_score: placed.iter().map(|p| p.score).fold(1.0, f64::min),
-                stands,
-                weakest: weakest(placed, super::WEAKEST),
-            });
-            end_checked = end;
-            if !stands && first_failure.is_none() {
-                first_failure = Some(step);
-                if stop_at_first_failure {
-                    break 'chunks;
-                }
+                reused += 1;
+            } else {
+                to_solve.push(job);
             }
         }
+        solves += to_solve.iter().filter(|j| j.grounded).count();
+        for (job, r) in to_solve.iter().zip(run(&s, &to_solve, params)?) {
+            for (&p, st) in job.pieces.iter().zip(r) {
+                current[p] = st;
+            }
+        }
+        steps.push(check(step, &current[..end]));
+        begin = end;
+        if first_failure.is_none() && !steps[steps.len() - 1].stands {
+            first_failure = Some(step);
+            if stop_at_first_failure {
+                break;
+            }
+        }
+    }
+    // The finished build (or the failing step) afresh.
+    let last = solve_all(&s, begin, params)?;
+    solves += 1;
+    if let Some(c) = steps.last_mut() {
+        *c = check(c.step, &last);
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(StepsAnalysis {
         steps,
         first_failure,
-        last: Analysis::new(current[..end_checked].to_vec(), seconds),
+        last: Analysis::new(last, seconds),
         seconds,
         solves,
         reused,
     })
+}
+
+/// The check of one intermediate build from its pieces' stress.
+fn check(step: u32, placed: &[PieceStress]) -> StepCheck {
+    StepCheck {
+        step,
+        min_score: placed.iter().map(|p| p.score).fold(1.0, f64::min),
+        stands: !placed.iter().any(PieceStress::fails),
+        weakest: weakest(placed, super::WEAKEST),
+    }
 }
