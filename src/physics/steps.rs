@@ -94,10 +94,18 @@ fn jobs_for_step(
         .collect()
 }
 
-/// Solves the jobs in parallel, in order: each job's stress per piece.
-fn run(
+/// Whether every piece a job adds (from `begin` on) rests straight down
+/// on the ground through the first `end` pieces.
+fn drops(s: &Structure, job: &Job, begin: usize, end: usize) -> bool {
+    job.pieces
+        .iter()
+        .all(|&p| p < begin || s.drops_straight(p, end))
+}
+
+/// [`run`] on borrowed jobs.
+fn run_refs(
     s: &Structure,
-    jobs: &[Job],
+    jobs: &[&Job],
     params: &Params,
 ) -> Result<Vec<Vec<PieceStress>>, PhysicsError> {
     jobs.par_iter()
@@ -109,6 +117,15 @@ fn run(
             solve(s, &job.pieces, &contacts, params).map(|r| r.stress)
         })
         .collect()
+}
+
+/// Solves the jobs in parallel, in order: each job's stress per piece.
+fn run(
+    s: &Structure,
+    jobs: &[Job],
+    params: &Params,
+) -> Result<Vec<Vec<PieceStress>>, PhysicsError> {
+    run_refs(s, &jobs.iter().collect::<Vec<_>>(), params)
 }
 
 /// Every piece of the first `n` pieces, all groups solved (in parallel).
@@ -164,32 +181,58 @@ pub fn analyze_steps(
     let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
+    // Every step's groups, and whether each needs a solve if everything
+    // before stood (the common case): those programs are solved up front,
+    // all steps in parallel.
+    let mut all_jobs: Vec<Vec<Job>> = Vec::with_capacity(bounds.len());
+    for &(_, end) in &bounds {
+        all_jobs.push(jobs_for_step(&s, &mut g, &mut next, end, &mut reused));
+    }
     let mut begin = 0;
-    for &(step, end) in &bounds {
-        let jobs = jobs_for_step(&s, &mut g, &mut next, end, &mut reused);
-        let mut to_solve = Vec::new();
-        for job in jobs {
+    let mut ahead: Vec<(usize, usize)> = Vec::new();
+    for (k, jobs) in all_jobs.iter().enumerate() {
+        let end = bounds[k].1;
+        for (j, job) in jobs.iter().enumerate() {
+            if !(job.grounded && drops(&s, job, begin, end)) {
+                ahead.push((k, j));
+            }
+        }
+        begin = end;
+    }
+    if stop_at_first_failure {
+        ahead.clear();
+    }
+    let ahead_jobs: Vec<&Job> = ahead.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
+    let mut solved: std::collections::HashMap<(usize, usize), Vec<PieceStress>> = ahead
+        .iter()
+        .copied()
+        .zip(run_refs(&s, &ahead_jobs, params)?)
+        .collect();
+    solves += ahead_jobs.iter().filter(|j| j.grounded).count();
+    let mut begin = 0;
+    for (k, jobs) in all_jobs.iter().enumerate() {
+        let (step, end) = bounds[k];
+        let mut late = Vec::new();
+        for (j, job) in jobs.iter().enumerate() {
             let stood = job
                 .pieces
                 .iter()
                 .all(|&p| p >= begin || !current[p].fails());
-            let certified = job.grounded
-                && stood
-                && job
-                    .pieces
-                    .iter()
-                    .all(|&p| p < begin || s.drops_straight(p, end));
-            if certified {
+            if let Some(r) = solved.remove(&(k, j)) {
+                for (&p, st) in job.pieces.iter().zip(r) {
+                    current[p] = st;
+                }
+            } else if job.grounded && stood && drops(&s, job, begin, end) {
                 for &p in job.pieces.iter().filter(|&&p| p >= begin) {
                     current[p] = PieceStress::resting();
                 }
                 reused += 1;
             } else {
-                to_solve.push(job);
+                late.push(job);
             }
         }
-        solves += to_solve.iter().filter(|j| j.grounded).count();
-        for (job, r) in to_solve.iter().zip(run(&s, &to_solve, params)?) {
+        solves += late.iter().filter(|j| j.grounded).count();
+        for (job, r) in late.iter().zip(run_refs(&s, &late, params)?) {
             for (&p, st) in job.pieces.iter().zip(r) {
                 current[p] = st;
             }
