@@ -277,7 +277,9 @@ pub enum BuildError {
     #[error("stability analysis: {0}")]
     Physics(crate::physics::PhysicsError),
     /// `--stability check` found a step that would not stand.
-    #[error("{file}: {reason} (--stability repair fixes what it can; --stability off skips the check)")]
+    #[error(
+        "{file}: {reason} (--stability repair fixes what it can; --stability off skips the check)"
+    )]
     Unstable {
         /// The input file.
         file: String,
@@ -497,9 +499,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         let search_opts = opts.search.clone().with_seed(seed);
         let outcome = search::build_guided(&model.grid, Some(&model.slant), &rules, &search_opts)
             .map_err(|reason| BuildError::Search {
-                file: file.clone(),
-                reason,
-            })?;
+            file: file.clone(),
+            reason,
+        })?;
         let t = Instant::now();
         let order = search::placements(&outcome);
         let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);

@@ -124,7 +124,9 @@ fn repair_reports_what_it_could_not_fix_and_draws_the_stress() {
         r["steps"].as_u64().unwrap()
     );
     // The stress picture has the falling pieces in red.
-    let img = image::open(out.join("gallows-stress.png")).unwrap().to_rgba8();
+    let img = image::open(out.join("gallows-stress.png"))
+        .unwrap()
+        .to_rgba8();
     let red = img
         .pixels()
         .filter(|p| p[0] > 150 && p[1] < 60 && p[2] < 60 && p[3] == 255)
@@ -154,7 +156,10 @@ fn a_model_that_stands_says_so_and_stress_needs_the_check() {
     assert!(st["first_failure"].is_null(), "{st}");
     let min = st["min_score"].as_f64().unwrap();
     let mean = st["mean_score"].as_f64().unwrap();
-    assert!((0.0..=1.0).contains(&min) && min <= mean && mean <= 1.0, "{st}");
+    assert!(
+        (0.0..=1.0).contains(&min) && min <= mean && mean <= 1.0,
+        "{st}"
+    );
     assert!(out.join("house-stress.png").is_file());
     let ldr = out.join("house.ldr");
     let verified = brickwright(&["verify", "--stability", s(&ldr)]);
@@ -220,7 +225,9 @@ fn the_order_repair_puts_the_counterweight_before_the_overhang() {
     let wrong = overhang_first();
     let check = analyze_steps(&wrong, &params, false).unwrap();
     assert_eq!(check.first_failure, Some(2));
-    let fixed = reorder(&wrong, &params, 2).unwrap().expect("a better order");
+    let fixed = reorder(&wrong, &params, 2)
+        .unwrap()
+        .expect("a better order");
     let parts: Vec<&str> = fixed
         .assembly
         .pieces

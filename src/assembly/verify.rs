@@ -591,10 +591,7 @@ mod tests {
     fn separate_pieces_are_disconnected() {
         let asm = build(&[("3005", 0, 0, 0, R0), ("3005", 1, 0, 0, R0)]);
         let report = verify(&asm, None);
-        assert_eq!(
-            report.failures,
-            [Failure::Disconnected { components: 2 }]
-        );
+        assert_eq!(report.failures, [Failure::Disconnected { components: 2 }]);
         assert!(
             report.to_string().contains("falls apart into 2"),
             "{report}"

@@ -113,8 +113,8 @@
 //! ```
 
 mod model;
-mod steps;
 pub mod repair;
+mod steps;
 
 use serde::Serialize;
 

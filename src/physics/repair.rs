@@ -170,7 +170,10 @@ pub fn reorder(
                     to_step: to,
                 });
             }
-            pieces.push(Placed { step: Step(to), ..p });
+            pieces.push(Placed {
+                step: Step(to),
+                ..p
+            });
         }
     }
     if moved.is_empty() {
@@ -254,7 +257,10 @@ fn failing_new(
     if !new.is_empty() {
         return new;
     }
-    let old: BTreeSet<usize> = (0..n_old).filter(|&k| fails(k)).map(|k| placed[k]).collect();
+    let old: BTreeSet<usize> = (0..n_old)
+        .filter(|&k| fails(k))
+        .map(|k| placed[k])
+        .collect();
     if old.is_empty() {
         return Vec::new();
     }

@@ -20,7 +20,9 @@ use serde::Serialize;
 use crate::assembly::verify::verify;
 use crate::assembly::Assembly;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
-use crate::physics::{analyze, analyze_steps, Analysis, Ground, Params, PhysicsError, StepsAnalysis};
+use crate::physics::{
+    analyze, analyze_steps, Analysis, Ground, Params, PhysicsError, StepsAnalysis,
+};
 use crate::search::SearchOutcome;
 
 /// What the stability stage does.
@@ -347,9 +349,7 @@ fn report(
         clutch_n_per_stud: params.clutch_n,
         stands: check.first_failure.is_none(),
         first_failure: check.first_failure,
-        failure: check
-            .first_failure
-            .map(|_| failure_line(assembly, check)),
+        failure: check.first_failure.map(|_| failure_line(assembly, check)),
         min_score: round(finished.min_score),
         mean_score: round(finished.mean_score),
         max_usage: round(finished.max_usage),
@@ -386,7 +386,11 @@ pub fn weak_pieces(assembly: &Assembly, analysis: &Analysis, pieces: &[usize]) -
                 step: p.step.0,
                 part: spec.id.0,
                 name: spec.name,
-                at: [p.placement.origin.x, p.placement.origin.y, p.placement.origin.z],
+                at: [
+                    p.placement.origin.x,
+                    p.placement.origin.y,
+                    p.placement.origin.z,
+                ],
                 usage: round(s.usage),
                 falls: s.falls,
             }
@@ -422,7 +426,11 @@ pub fn failure_line(assembly: &Assembly, check: &StepsAnalysis) -> String {
     format!(
         "at step {step} the build would not stand: {}{}",
         listed.join(", "),
-        if more > 0 { format!(" and {more} more") } else { String::new() }
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        }
     )
 }
 
