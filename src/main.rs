@@ -217,6 +217,10 @@ struct BuildArgs {
     /// check fails the build when a step would not stand, off skips the check.
     #[arg(long, value_enum, default_value_t = StabilityArg::Repair)]
     stability: StabilityArg,
+    /// Time for the stability check and its repairs, in seconds; past it, no further step is
+    /// checked (the finished model always is), and the report says how far it got.
+    #[arg(long, value_name = "SECS", default_value_t = 120.0)]
+    stability_budget: f64,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -279,6 +283,10 @@ fn run_build(a: BuildArgs) -> Result<()> {
     });
     opts.formats = a.formats;
     opts.template = a.template;
+    if !(a.stability_budget.is_finite() && a.stability_budget > 0.0) {
+        anyhow::bail!("--stability-budget must be a positive number of seconds");
+    }
+    opts.stability_budget = Duration::from_secs_f64(a.stability_budget);
     opts.stability = match a.stability {
         StabilityArg::Repair => pipeline::Stability::Repair,
         StabilityArg::Check => pipeline::Stability::Check,
@@ -378,9 +386,13 @@ fn run_build(a: BuildArgs) -> Result<()> {
 
 /// The stability lines of the build summary.
 fn print_build_stability(st: &pipeline::StabilityReport) {
-    let verdict = match st.first_failure {
-        None => "stands at every step".to_string(),
-        Some(step) => format!("warning: does not stand from step {step} on"),
+    let verdict = match (st.first_failure, st.complete) {
+        (None, true) => "stands at every step".to_string(),
+        (None, false) => format!(
+            "warning: checked {} steps before its time budget ran out (raise --stability-budget); they and the finished model stand",
+            st.steps_checked
+        ),
+        (Some(step), _) => format!("warning: does not stand from step {step} on"),
     };
     outln!(
         "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} analyses)",

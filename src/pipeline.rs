@@ -69,7 +69,15 @@ pub struct BuildOptions {
     pub template: Option<PathBuf>,
     /// The stability stage. Default [`Stability::Repair`].
     pub stability: Stability,
+    /// Time for the stability stage; past it, no further step is checked
+    /// or repaired (the finished model always is). Default
+    /// [`DEFAULT_STABILITY_BUDGET`].
+    #[serde(skip)]
+    pub stability_budget: std::time::Duration,
 }
+
+/// Default time for the stability stage: two minutes.
+pub const DEFAULT_STABILITY_BUDGET: std::time::Duration = std::time::Duration::from_secs(120);
 
 /// A file `brickwright build` can write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -230,6 +238,7 @@ impl BuildOptions {
             formats: Formats::default(),
             template: None,
             stability: Stability::default(),
+            stability_budget: DEFAULT_STABILITY_BUDGET,
         }
     }
 }
@@ -537,9 +546,15 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             progress.stage("checking stability");
             let t = Instant::now();
             let params = crate::physics::Params::default();
-            let (planned, report, finished) =
-                stability::settle(mode, first, opts.search.seed, &params, &plan)?;
-            if mode == Stability::Check && !report.stands {
+            let (planned, report, finished) = stability::settle(
+                mode,
+                first,
+                opts.search.seed,
+                &params,
+                opts.stability_budget,
+                &plan,
+            )?;
+            if mode == Stability::Check && report.first_failure.is_some() {
                 return Err(BuildError::Unstable {
                     file,
                     reason: report.failure.clone().unwrap_or_default(),

@@ -200,6 +200,35 @@ fn a_model_that_stands_says_so_and_stress_needs_the_check() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("--formats stress"));
 }
 
+#[test]
+fn the_check_stops_at_its_time_budget_and_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
+    let out = tmp.path().join("out");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "10",
+        "-o",
+        s(&out),
+        "--formats",
+        "ldr",
+        "--stability-budget",
+        "0.000001",
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    assert!(stdout.contains("--stability-budget"), "{stdout}");
+    let r = report(&out);
+    let st = &r["stability"];
+    assert_eq!(st["complete"], false, "{st}");
+    assert_eq!(st["stands"], false, "unchecked steps are not claimed: {st}");
+    assert!(st["steps_checked"].as_u64().unwrap() < r["steps"].as_u64().unwrap());
+    // The finished model is still analysed.
+    assert!(st["mean_score"].as_f64().unwrap() > 0.0, "{st}");
+}
+
 /// A 1x4 base on the table, a 1x6 overhang clutched to its last stud, and
 /// a 1x2 counterweight on its other end: built overhang first, the base
 /// tips at step 2 (the known answer of tests/physics.rs).
@@ -225,7 +254,7 @@ fn the_order_repair_puts_the_counterweight_before_the_overhang() {
     let wrong = overhang_first();
     let check = analyze_steps(&wrong, &params, false).unwrap();
     assert_eq!(check.first_failure, Some(2));
-    let fixed = reorder(&wrong, &params, 2)
+    let fixed = reorder(&wrong, &params, 2, None)
         .unwrap()
         .expect("a better order");
     let parts: Vec<&str> = fixed

@@ -123,7 +123,7 @@ use crate::catalog::PartSpec;
 
 use crate::assembly::Assembly;
 
-pub use steps::analyze_steps;
+pub use steps::{analyze_steps, analyze_steps_within};
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
 /// for where it comes from).
@@ -349,6 +349,10 @@ pub struct StepsAnalysis {
     /// untouched, or grown only by pieces resting straight on the ground
     /// through compression.
     pub reused: usize,
+    /// Every step up to the end (or the first failure, when asked to stop
+    /// there) was checked; false when the deadline of
+    /// [`analyze_steps_within`] cut the check short.
+    pub complete: bool,
 }
 
 /// Why an analysis failed.

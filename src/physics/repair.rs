@@ -57,11 +57,12 @@ pub const MAX_REPAIRED_STEP: usize = 3 * crate::assembly::STEP_PIECES;
 /// that the pieces which break off or fall are added only once the
 /// structure holds them. `None` when nothing could be moved, or when the
 /// structure would hold them only in a step of more than
-/// [`MAX_REPAIRED_STEP`] pieces.
+/// [`MAX_REPAIRED_STEP`] pieces, or the deadline passed first.
 pub fn reorder(
     assembly: &Assembly,
     params: &Params,
     first_failure: u32,
+    deadline: Option<std::time::Instant>,
 ) -> Result<Option<Reordered>, PhysicsError> {
     let n = assembly.pieces.len();
     let bodies: Vec<_> = assembly
@@ -103,7 +104,7 @@ pub fn reorder(
             }
             // The step's own pieces first, then those it now holds.
             kept.sort_by_key(|&i| (was_deferred[i], i));
-            if solves >= budget {
+            if solves >= budget || deadline.is_some_and(|d| std::time::Instant::now() >= d) {
                 return Ok(None);
             }
             solves += 1;

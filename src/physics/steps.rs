@@ -165,6 +165,24 @@ pub fn analyze_steps(
     params: &Params,
     stop_at_first_failure: bool,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    analyze_steps_within(assembly, params, stop_at_first_failure, None)
+}
+
+/// Steps whose programs are solved together, in parallel, between looks
+/// at the deadline.
+const STEPS_A_BATCH: usize = 16;
+
+/// [`analyze_steps`] with a deadline: once it has passed, no further step
+/// is checked ([`StepsAnalysis::complete`] is false and `steps` ends at the
+/// last step checked), but the finished build is still analysed whole;
+/// when it fails and no checked step did, `first_failure` is the last
+/// step.
+pub fn analyze_steps_within(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<std::time::Instant>,
+) -> Result<StepsAnalysis, PhysicsError> {
     let start = std::time::Instant::now();
     params.check()?;
     let s = Structure::new(assembly, params);
@@ -202,15 +220,26 @@ pub fn analyze_steps(
     if stop_at_first_failure {
         ahead.clear();
     }
-    let ahead_jobs: Vec<&Job> = ahead.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
-    let mut solved: std::collections::HashMap<(usize, usize), Vec<PieceStress>> = ahead
-        .iter()
-        .copied()
-        .zip(run_refs(&s, &ahead_jobs, params)?)
-        .collect();
-    solves += ahead_jobs.iter().filter(|j| j.grounded).count();
+    let mut solved: std::collections::HashMap<(usize, usize), Vec<PieceStress>> =
+        std::collections::HashMap::new();
     let mut begin = 0;
+    let mut complete = true;
     for (k, jobs) in all_jobs.iter().enumerate() {
+        if k % STEPS_A_BATCH == 0 {
+            if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                complete = false;
+                break;
+            }
+            // This batch's programs, all at once.
+            let batch: Vec<(usize, usize)> = ahead
+                .iter()
+                .copied()
+                .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
+                .collect();
+            let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
+            solves += batch_jobs.iter().filter(|j| j.grounded).count();
+            solved.extend(batch.into_iter().zip(run_refs(&s, &batch_jobs, params)?));
+        }
         let (step, end) = bounds[k];
         let mut late = Vec::new();
         for (j, job) in jobs.iter().enumerate() {
@@ -246,11 +275,23 @@ pub fn analyze_steps(
             }
         }
     }
-    // The finished build (or the failing step) afresh.
-    let last = solve_all(&s, begin, params)?;
+    // The finished build (or the failing step) afresh; past the deadline,
+    // the finished build.
+    let end = if complete {
+        begin
+    } else {
+        assembly.pieces.len()
+    };
+    let last = solve_all(&s, end, params)?;
     solves += 1;
-    if let Some(c) = steps.last_mut() {
-        *c = check(c.step, &last);
+    if !complete && first_failure.is_none() && last.iter().any(PieceStress::fails) {
+        // Unchecked steps in between: the finished build is known to fail.
+        first_failure = assembly.pieces.last().map(|p| p.step.0);
+    }
+    if complete {
+        if let Some(c) = steps.last_mut() {
+            *c = check(c.step, &last);
+        }
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(StepsAnalysis {
@@ -260,6 +301,7 @@ pub fn analyze_steps(
         seconds,
         solves,
         reused,
+        complete,
     })
 }
 

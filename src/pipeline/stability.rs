@@ -13,7 +13,7 @@
 //! `--stability check` reports and fails the build; `--stability off`
 //! skips the stage.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
@@ -21,7 +21,7 @@ use crate::assembly::verify::verify;
 use crate::assembly::Assembly;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
 use crate::physics::{
-    analyze, analyze_steps, Analysis, Ground, Params, PhysicsError, StepsAnalysis,
+    analyze, analyze_steps_within, Analysis, Ground, Params, PhysicsError, StepsAnalysis,
 };
 use crate::search::SearchOutcome;
 
@@ -132,6 +132,12 @@ pub struct StabilityReport {
     /// When the build still fails on a table: whether it would stand at
     /// every step on a baseplate (which holds the bottom course's studs).
     pub stands_on_baseplate: Option<bool>,
+    /// Every step was checked; false when the stage's time budget
+    /// (`--stability-budget`) ran out first (the finished model is always
+    /// analysed).
+    pub complete: bool,
+    /// Steps checked.
+    pub steps_checked: usize,
     /// Force analyses solved, and reused from the step before.
     pub solves: usize,
     /// Analyses reused.
@@ -149,10 +155,18 @@ pub fn settle(
     plan: Plan,
     seed: u64,
     params: &Params,
+    budget: Duration,
     replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
+    let deadline = Instant::now() + budget;
     let mut counts = Counts::default();
-    let first = attempt(plan, params, mode == Stability::Repair, &mut counts)?;
+    let first = attempt(
+        plan,
+        params,
+        mode == Stability::Repair,
+        deadline,
+        &mut counts,
+    )?;
     let before = Before {
         first_failure: first.check.first_failure,
         min_score: first.check.last.min_score,
@@ -164,6 +178,9 @@ pub fn settle(
         // Other layouts of the same voxels; the first that stands at every
         // step (after its own order repair) is kept, else the best tried.
         for k in 1..=RESEEDS {
+            if Instant::now() >= deadline {
+                break;
+            }
             let other = seed.wrapping_add(k);
             let planned = replan(other)?;
             // The finished model first: one analysis rules most layouts out.
@@ -174,7 +191,7 @@ pub fn settle(
             {
                 continue;
             }
-            let candidate = attempt(planned, params, true, &mut counts)?;
+            let candidate = attempt(planned, params, true, deadline, &mut counts)?;
             if candidate.better_than(&best) {
                 best = candidate;
                 reseeded = Some(other);
@@ -219,9 +236,9 @@ pub fn settle(
             ground: Ground::Baseplate,
             ..*params
         };
-        let c = analyze_steps(&best.plan.1, &base, true)?;
+        let c = analyze_steps_within(&best.plan.1, &base, true, Some(deadline))?;
         counts.add(&c);
-        on_baseplate = Some(c.first_failure.is_none());
+        on_baseplate = c.complete.then_some(c.first_failure.is_none());
     }
     let Attempt {
         plan,
@@ -291,21 +308,22 @@ fn attempt(
     plan: Plan,
     params: &Params,
     repair: bool,
+    deadline: Instant,
     counts: &mut Counts,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
-    let mut check = analyze_steps(&plan.1, params, false)?;
+    let mut check = analyze_steps_within(&plan.1, params, false, Some(deadline))?;
     counts.add(&check);
     let mut order_fix = None;
     let mut order_tried = None;
     if let (true, true, Some(step)) = (repair, check.last.stands(), check.first_failure) {
         order_tried = Some(step);
-        if let Some(r) = reorder(&plan.1, params, step)? {
+        if let Some(r) = reorder(&plan.1, params, step, Some(deadline))? {
             counts.solves += r.solves;
             if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
-                let c = analyze_steps(&r.assembly, params, false)?;
+                let c = analyze_steps_within(&r.assembly, params, false, Some(deadline))?;
                 counts.add(&c);
-                if later(c.first_failure, check.first_failure) {
+                if c.complete && later(c.first_failure, check.first_failure) {
                     order_fix = Some(r.moved);
                     plan.1 = r.assembly;
                     check = c;
@@ -347,7 +365,7 @@ fn report(
     StabilityReport {
         mode: mode.name(),
         clutch_n_per_stud: params.clutch_n,
-        stands: check.first_failure.is_none(),
+        stands: check.first_failure.is_none() && check.complete,
         first_failure: check.first_failure,
         failure: check.first_failure.map(|_| failure_line(assembly, check)),
         min_score: round(finished.min_score),
@@ -368,6 +386,8 @@ fn report(
         reseeded,
         before,
         stands_on_baseplate: None,
+        complete: check.complete,
+        steps_checked: check.steps.len(),
         solves,
         reused,
     }
