@@ -71,6 +71,10 @@ pub fn reorder(
         .map(|p| p.placement.body(assembly.layer_ldu))
         .collect();
     let neighbours = crate::assembly::verify::connections(&bodies);
+    // Pieces on the ground may start a part of their own, as the verifier
+    // allows.
+    let ground = bodies.iter().map(|b| b.bbox.min.z).min().unwrap_or(0);
+    let on_ground: Vec<bool> = bodies.iter().map(|b| b.bbox.min.z == ground).collect();
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for (i, p) in assembly.pieces.iter().enumerate() {
         match groups.last_mut() {
@@ -98,7 +102,7 @@ pub fn reorder(
         let mut trial: BTreeSet<usize> = deferred.iter().copied().chain(group).collect();
         let mut held: BTreeSet<usize> = BTreeSet::new();
         loop {
-            let mut kept = connected(&trial, &is_placed, &neighbours, placed.is_empty());
+            let mut kept = connected(&trial, &is_placed, &on_ground, &neighbours);
             if kept.is_empty() {
                 break;
             }
@@ -139,10 +143,11 @@ pub fn reorder(
         let mut rest: Vec<usize> = deferred.into_iter().collect();
         while !rest.is_empty() {
             let set: BTreeSet<usize> = rest.iter().copied().collect();
-            let kept = connected(&set, &is_placed, &neighbours, placed.is_empty());
+            let kept = connected(&set, &is_placed, &on_ground, &neighbours);
             if kept.is_empty() {
-                // Cannot happen for a verified build: every piece joins the
-                // one structure. Keep the pieces rather than lose them.
+                // Cannot happen for a verified build: every piece is on the
+                // ground or joins the structure. Keep the pieces rather than
+                // lose them.
                 steps.push(std::mem::take(&mut rest));
                 break;
             }
@@ -191,15 +196,15 @@ pub fn reorder(
     }))
 }
 
-/// The pieces of `trial` that join what is built, in order: each connects
-/// to a placed piece or to one kept before it (the first piece of an
-/// empty build needs nothing). Pieces that only connect through a later
-/// one are found by repeating the pass.
+/// The pieces of `trial` that join what is built, in order: each stands
+/// on the ground or connects to a placed piece or to one kept before it.
+/// Pieces that only connect through a later one are found by repeating
+/// the pass.
 fn connected(
     trial: &BTreeSet<usize>,
     is_placed: &[bool],
+    on_ground: &[bool],
     neighbours: &[Vec<usize>],
-    empty: bool,
 ) -> Vec<usize> {
     let mut kept: Vec<usize> = Vec::new();
     let mut in_kept = BTreeSet::new();
@@ -209,7 +214,7 @@ fn connected(
             if in_kept.contains(&i) {
                 continue;
             }
-            let joins = (empty && kept.is_empty())
+            let joins = on_ground[i]
                 || neighbours[i]
                     .iter()
                     .any(|&j| is_placed[j] || in_kept.contains(&j));

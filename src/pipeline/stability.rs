@@ -247,7 +247,7 @@ pub fn settle(
         ..
     } = best;
     let repaired = mode == Stability::Repair && before.first_failure.is_some();
-    let mut report = report(
+    let report = report(
         mode,
         params,
         &plan.1,
@@ -256,10 +256,9 @@ pub fn settle(
         order_fix.unwrap_or_default(),
         reseeded,
         repaired.then_some(before),
-        counts.solves,
-        counts.reused,
+        on_baseplate,
+        counts,
     );
-    report.stands_on_baseplate = on_baseplate;
     Ok((plan, report, check.last))
 }
 
@@ -358,8 +357,8 @@ fn report(
     moved: Vec<Moved>,
     reseeded: Option<u64>,
     before: Option<Before>,
-    solves: usize,
-    reused: usize,
+    stands_on_baseplate: Option<bool>,
+    counts: Counts,
 ) -> StabilityReport {
     let finished = &check.last;
     StabilityReport {
@@ -385,16 +384,16 @@ fn report(
         moved,
         reseeded,
         before,
-        stands_on_baseplate: None,
+        stands_on_baseplate,
         complete: check.complete,
         steps_checked: check.steps.len(),
-        solves,
-        reused,
+        solves: counts.solves,
+        reused: counts.reused,
     }
 }
 
 /// The listed pieces of `assembly`, as the report shows them.
-pub fn weak_pieces(assembly: &Assembly, analysis: &Analysis, pieces: &[usize]) -> Vec<WeakPiece> {
+fn weak_pieces(assembly: &Assembly, analysis: &Analysis, pieces: &[usize]) -> Vec<WeakPiece> {
     pieces
         .iter()
         .map(|&i| {
@@ -419,7 +418,7 @@ pub fn weak_pieces(assembly: &Assembly, analysis: &Analysis, pieces: &[usize]) -
 }
 
 /// The one-line reason a build fails `--stability check`.
-pub fn failure_line(assembly: &Assembly, check: &StepsAnalysis) -> String {
+fn failure_line(assembly: &Assembly, check: &StepsAnalysis) -> String {
     let Some(step) = check.first_failure else {
         return String::new();
     };
@@ -462,9 +461,4 @@ impl From<PhysicsError> for crate::pipeline::BuildError {
     fn from(e: PhysicsError) -> Self {
         crate::pipeline::BuildError::Physics(e)
     }
-}
-
-/// Seconds since `t`, for the report.
-pub fn since(t: Instant) -> f64 {
-    (t.elapsed().as_secs_f64() * 1000.0).round() / 1000.0
 }
