@@ -213,14 +213,19 @@ struct BuildArgs {
     #[arg(long, value_name = "FILE")]
     template: Option<PathBuf>,
     /// Check that the build stands at every step (static forces, clutch at the studs):
-    /// repair fixes what fails (another layout, or weak pieces moved to later steps),
-    /// check fails the build when a step would not stand, off skips the check.
+    /// repair fixes what fails (support columns under what the model cannot hold itself,
+    /// another layout, or weak pieces moved to later steps), check fails the build when a
+    /// step would not stand, off skips the check.
     #[arg(long, value_enum, default_value_t = StabilityArg::Repair)]
     stability: StabilityArg,
     /// Time for the stability check and its repairs, in seconds; past it, no further step is
     /// checked (the finished model always is), and the report says how far it got.
     #[arg(long, value_name = "SECS", default_value_t = 120.0)]
     stability_budget: f64,
+    /// Repair without support columns: only other layouts and orders of the model's own
+    /// pieces (for a model to be built on a baseplate, say).
+    #[arg(long)]
+    no_supports: bool,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
@@ -287,6 +292,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
         anyhow::bail!("--stability-budget must be a positive number of seconds");
     }
     opts.stability_budget = Duration::from_secs_f64(a.stability_budget);
+    opts.supports = !a.no_supports;
     opts.stability = match a.stability {
         StabilityArg::Repair => pipeline::Stability::Repair,
         StabilityArg::Check => pipeline::Stability::Check,

@@ -74,6 +74,10 @@ pub struct BuildOptions {
     /// [`DEFAULT_STABILITY_BUDGET`].
     #[serde(skip)]
     pub stability_budget: std::time::Duration,
+    /// Whether the stability repair may add support columns (pieces of
+    /// their own colour under what the model cannot hold itself). Default
+    /// true.
+    pub supports: bool,
 }
 
 /// Default time for the stability stage: two minutes.
@@ -239,6 +243,7 @@ impl BuildOptions {
             template: None,
             stability: Stability::default(),
             stability_budget: DEFAULT_STABILITY_BUDGET,
+            supports: true,
         }
     }
 }
@@ -552,6 +557,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 opts.search.seed,
                 &params,
                 opts.stability_budget,
+                opts.supports,
                 &plan,
             )?;
             if mode == Stability::Check && report.first_failure.is_some() {

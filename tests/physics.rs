@@ -8,7 +8,9 @@
 use brickwright::assembly::{Assembly, Placed, Placement, Step, StepGrouping};
 use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
-use brickwright::physics::{analyze, analyze_steps, Ground, Params, CLUTCH_N, GRAVITY};
+use brickwright::physics::{
+    analyze, analyze_steps, analyze_steps_from, Ground, Params, CLUTCH_N, GRAVITY,
+};
 
 use Rot::{R0, R90};
 
@@ -150,6 +152,43 @@ fn a_bridge_stands_only_once_its_keystone_is_in() {
     let whole = analyze(&asm, &params).unwrap();
     assert!(whole.stands());
     assert_eq!(whole.pieces, steps.last.pieces);
+}
+
+#[test]
+fn checking_from_a_later_step_agrees_with_checking_every_step() {
+    // The bridge again, one piece a step: steps before `from` are taken as
+    // standing; the rest must read exactly as a check from step 1 does.
+    let asm = build(&[
+        ("3004", 0, 0, 0, R0, 1),
+        ("3004", 0, 0, 1, R0, 2),
+        ("3004", 16, 0, 0, R0, 3),
+        ("3004", 16, 0, 1, R0, 4),
+        ("3008", 1, 0, 2, R0, 5),
+        ("3008", 9, 0, 2, R0, 6),
+        ("3010", 7, 0, 3, R0, 7),
+    ]);
+    let params = Params::default();
+    let all = analyze_steps(&asm, &params, false).unwrap();
+    assert_eq!(all.first_failure, Some(5));
+    for from in 1..=7 {
+        let part = analyze_steps_from(&asm, &params, false, None, from).unwrap();
+        let tail: Vec<_> = all.steps.iter().filter(|s| s.step >= from).collect();
+        assert_eq!(part.steps.len(), tail.len(), "from {from}");
+        for (a, b) in part.steps.iter().zip(tail) {
+            assert_eq!(a.step, b.step);
+            assert_eq!(a.stands, b.stands, "step {} from {from}", a.step);
+            assert!(
+                (a.min_score - b.min_score).abs() < 1e-6,
+                "step {} from {from}",
+                a.step
+            );
+        }
+        assert_eq!(
+            part.first_failure,
+            if from <= 6 { Some(from.max(5)) } else { None }
+        );
+        assert_eq!(part.last.pieces, all.last.pieces);
+    }
 }
 
 /// A 1x4 base on a table, a 1x6 overhang clutched to its last stud

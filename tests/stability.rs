@@ -1,7 +1,9 @@
 //! The build's stability stage end to end: `--stability check` refuses a
-//! build that would tip over, the default repair reports it (and writes the
-//! stress picture), a model that stands says so, and the order repair
-//! builds a counterweight before the overhang it holds.
+//! build that would tip over, the default repair props it with a support
+//! column (and the stress picture shows it holds), the repair without
+//! supports reports what it could not fix, a model that stands says so,
+//! and the order repair builds a counterweight before the overhang it
+//! holds.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -91,8 +93,18 @@ fn check_refuses_a_build_that_tips_over_with_one_line_and_no_files() {
     assert!(!out.exists(), "no files on failure");
 }
 
+/// Pixels of `img` that read as the stress ramp's red end, but for the
+/// legend's own ramp (bottom right).
+fn red_pixels(img: &image::RgbaImage) -> usize {
+    let (w, h) = img.dimensions();
+    img.enumerate_pixels()
+        .filter(|(x, y, _)| !(*x > w / 2 && *y > h * 4 / 5))
+        .filter(|(_, _, p)| p[0] > 150 && p[1] < 60 && p[2] < 60 && p[3] == 255)
+        .count()
+}
+
 #[test]
-fn repair_reports_what_it_could_not_fix_and_draws_the_stress() {
+fn repair_props_the_gallows_arm_with_a_support_column() {
     let tmp = tempfile::tempdir().unwrap();
     let mesh = write_gallows(tmp.path());
     let out = tmp.path().join("out");
@@ -105,6 +117,80 @@ fn repair_reports_what_it_could_not_fix_and_draws_the_stress() {
         s(&out),
         "--formats",
         "ldr,stress",
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    assert!(stdout.contains("repaired supports: "), "{stdout}");
+    assert!(stdout.contains("stands at every step"), "{stdout}");
+    let r = report(&out);
+    let st = &r["stability"];
+    assert_eq!(st["stands"], true, "{st}");
+    // It did not stand before: the arm tipped the post.
+    assert!(st["before"]["first_failure"].as_u64().is_some(), "{st}");
+    assert_eq!(st["before"]["final_stands"], false, "{st}");
+    let columns = st["supports"].as_array().unwrap();
+    assert!(!columns.is_empty(), "{st}");
+    let ldr = std::fs::read_to_string(out.join("gallows.ldr")).unwrap();
+    // The arm (the 1 x 6, six studs long from x = 1) and where it is put.
+    let lines: Vec<Vec<&str>> = ldr
+        .lines()
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    let arm_line = lines
+        .iter()
+        .position(|l| l.first() == Some(&"1") && l.last() == Some(&"3009.dat"))
+        .expect("the arm");
+    let mut pieces_in_columns = 0;
+    for c in columns {
+        // Under the arm, from the table up to it, one stud from the post at
+        // least, and added before it.
+        let x = c["x"].as_i64().unwrap();
+        assert!((2..=6).contains(&x), "{c}");
+        assert_eq!(c["on_ground"], true, "{c}");
+        assert_eq!(c["bottom"], 0, "{c}");
+        pieces_in_columns += c["pieces"].as_u64().unwrap();
+    }
+    assert_eq!(st["support_pieces"].as_u64(), Some(pieces_in_columns));
+    // The columns' bricks: light bluish grey (71) 1 x 1s, all before the arm.
+    let support_lines: Vec<usize> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.first() == Some(&"1") && l[1] == "71")
+        .map(|(i, l)| {
+            assert_eq!(l.last(), Some(&"3005.dat"));
+            i
+        })
+        .collect();
+    assert_eq!(support_lines.len() as u64, pieces_in_columns);
+    assert!(support_lines.iter().all(|&i| i < arm_line), "{ldr}");
+    // Any checker agrees: the written model stands.
+    let verified = brickwright(&["verify", "--stability", s(&out.join("gallows.ldr"))]);
+    assert!(
+        verified.status.success(),
+        "{}",
+        String::from_utf8_lossy(&verified.stdout)
+    );
+    let img = image::open(out.join("gallows-stress.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_eq!(red_pixels(&img), 0, "no red on the model");
+}
+
+#[test]
+fn repair_without_supports_reports_what_it_could_not_fix_and_draws_the_stress() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = write_gallows(tmp.path());
+    let out = tmp.path().join("out");
+    let run = brickwright(&[
+        "build",
+        s(&mesh),
+        "--studs",
+        "7",
+        "-o",
+        s(&out),
+        "--formats",
+        "ldr,stress",
+        "--no-supports",
     ]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
@@ -124,13 +210,11 @@ fn repair_reports_what_it_could_not_fix_and_draws_the_stress() {
         r["steps"].as_u64().unwrap()
     );
     // The stress picture has the falling pieces in red.
+    assert!(st["supports"].as_array().unwrap().is_empty(), "{st}");
     let img = image::open(out.join("gallows-stress.png"))
         .unwrap()
         .to_rgba8();
-    let red = img
-        .pixels()
-        .filter(|p| p[0] > 150 && p[1] < 60 && p[2] < 60 && p[3] == 255)
-        .count();
+    let red = red_pixels(&img);
     assert!(red > 500, "{red} red pixels");
 }
 

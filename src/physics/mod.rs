@@ -115,6 +115,7 @@
 mod model;
 pub mod repair;
 mod steps;
+pub mod support;
 
 use serde::Serialize;
 
@@ -123,7 +124,7 @@ use crate::catalog::PartSpec;
 
 use crate::assembly::Assembly;
 
-pub use steps::{analyze_steps, analyze_steps_within};
+pub use steps::{analyze_steps, analyze_steps_from, analyze_steps_within};
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
 /// for where it comes from).

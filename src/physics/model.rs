@@ -265,6 +265,25 @@ fn rows(local: usize, com: (f64, f64), (x, y): (f64, f64), f: f64) -> [(usize, f
 pub(super) struct Solved {
     /// Per piece of the group, in the group's order.
     pub stress: Vec<PieceStress>,
+    /// Per prop of [`Props`], the force it carries.
+    pub props: Vec<f64>,
+}
+
+/// An upward force a support column could give: under `piece` at `at`,
+/// pushing down on `lands_on` (or on the ground).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Prop {
+    pub piece: usize,
+    pub at: (f64, f64),
+    pub lands_on: Option<usize>,
+    /// Cost of a unit of force.
+    pub cost: f64,
+}
+
+/// Props the program may use, and the usage no joint may pass.
+pub(super) struct Props<'a> {
+    pub props: &'a [Prop],
+    pub cap: f64,
 }
 
 /// Solves the group `pieces` (sorted) with the `contacts` among them.
@@ -274,17 +293,33 @@ pub(super) fn solve(
     contacts: &[&Contact],
     params: &Params,
 ) -> Result<Solved, PhysicsError> {
+    solve_propped(s, pieces, contacts, params, None)
+}
+
+/// [`solve`], where `props` may also push pieces up and every joint's
+/// usage is held to at most `props.cap`: the props a structure needs to
+/// hold with that margin (a hand still holds what no prop can).
+pub(super) fn solve_propped(
+    s: &Structure,
+    pieces: &[usize],
+    contacts: &[&Contact],
+    params: &Params,
+    extra: Option<&Props>,
+) -> Result<Solved, PhysicsError> {
     let n = pieces.len();
     let local = |p: usize| pieces.binary_search(&p).expect("piece of the group");
+    let props: &[Prop] = extra.map_or(&[], |e| e.props);
     // Count the columns and the capacity rows first: the x >= 0 rows
     // follow the equilibrium rows, the capacity rows follow those.
-    let mut cols = 4 * n;
+    let mut cols = 4 * n + props.len();
     let mut caps = 0;
+    let mut joint_count = 0;
     for c in contacts {
         cols += if c.face.is_some() { 4 } else { 0 };
         if !c.studs.is_empty() {
             cols += c.studs.len() + 1;
             caps += c.studs.len();
+            joint_count += 1;
         }
     }
     for &p in pieces {
@@ -293,8 +328,12 @@ pub(super) fn solve(
         if !l.ground_studs.is_empty() {
             cols += l.ground_studs.len() + 1;
             caps += l.ground_studs.len();
+            joint_count += 1;
         }
     }
+    // With props, a row `m_j <= cap` per joint follows the capacity rows.
+    let limits = if extra.is_some() { joint_count } else { 0 };
+    let mut next_limit = 3 * n + cols + caps;
     let eq = 3 * n;
     let mut lp = Lp {
         colptr: vec![0],
@@ -328,9 +367,13 @@ pub(super) fn solve(
                 e.push((cap0 + k, 1.0));
                 lp.column(TENSION_COST, &e);
             }
-            let caps_rows: Vec<(usize, f64)> = (0..l.ground_studs.len())
+            let mut caps_rows: Vec<(usize, f64)> = (0..l.ground_studs.len())
                 .map(|k| (cap0 + k, -1.0))
                 .collect();
+            if extra.is_some() {
+                caps_rows.push((next_limit, 1.0));
+                next_limit += 1;
+            }
             let m = lp.column(1.0, &caps_rows);
             joints.push((i, None, m));
         }
@@ -354,24 +397,42 @@ pub(super) fn solve(
                 e.push((cap0 + k, 1.0));
                 lp.column(TENSION_COST, &e);
             }
-            let caps_rows: Vec<(usize, f64)> =
+            let mut caps_rows: Vec<(usize, f64)> =
                 (0..c.studs.len()).map(|k| (cap0 + k, -1.0)).collect();
+            if extra.is_some() {
+                caps_rows.push((next_limit, 1.0));
+                next_limit += 1;
+            }
             let m = lp.column(1.0, &caps_rows);
             joints.push((a, Some(b), m));
         }
     }
+    let first_prop = lp.cost.len();
+    for prop in props {
+        let mut e = rows(local(prop.piece), s.loads[prop.piece].com, prop.at, 1.0).to_vec();
+        if let Some(q) = prop.lands_on {
+            e.extend(rows(local(q), s.loads[q].com, prop.at, -1.0));
+        }
+        lp.column(prop.cost, &e);
+    }
     debug_assert_eq!(lp.cost.len(), cols);
     debug_assert_eq!(lp.next_cap, eq + cols + caps);
-    let m_rows = eq + cols + caps;
+    debug_assert_eq!(next_limit, eq + cols + caps + limits);
+    let m_rows = eq + cols + caps + limits;
     let mut b = vec![0.0; m_rows];
     for (i, &p) in pieces.iter().enumerate() {
         b[3 * i] = s.loads[p].weight;
+    }
+    if let Some(e) = extra {
+        for r in &mut b[eq + cols + caps..] {
+            *r = e.cap;
+        }
     }
     let a = CscMatrix::new(m_rows, cols, lp.colptr, lp.rowval, lp.nzval);
     let pm = CscMatrix::zeros((cols, cols));
     let cones = [
         SupportedConeT::ZeroConeT(eq),
-        SupportedConeT::NonnegativeConeT(cols + caps),
+        SupportedConeT::NonnegativeConeT(cols + caps + limits),
     ];
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
@@ -413,5 +474,9 @@ pub(super) fn solve(
     for st in &mut stress {
         st.finish();
     }
-    Ok(Solved { stress })
+    let props = x[first_prop..first_prop + props.len()]
+        .iter()
+        .map(|f| f.max(0.0))
+        .collect();
+    Ok(Solved { stress, props })
 }

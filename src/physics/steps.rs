@@ -183,6 +183,21 @@ pub fn analyze_steps_within(
     stop_at_first_failure: bool,
     deadline: Option<std::time::Instant>,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    analyze_steps_from(assembly, params, stop_at_first_failure, deadline, 1)
+}
+
+/// [`analyze_steps_within`] for a build whose steps before `from` are
+/// known to stand (checked before a change that left them as they were):
+/// those steps are neither solved nor listed in
+/// [`StepsAnalysis::steps`]; step `from` is solved whole, and the later
+/// ones step by step as usual.
+pub fn analyze_steps_from(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<std::time::Instant>,
+    from: u32,
+) -> Result<StepsAnalysis, PhysicsError> {
     let start = std::time::Instant::now();
     params.check()?;
     let s = Structure::new(assembly, params);
@@ -206,10 +221,20 @@ pub fn analyze_steps_within(
     for &(_, end) in &bounds {
         all_jobs.push(jobs_for_step(&s, &mut g, &mut next, end, &mut reused));
     }
+    // The first step checked: solved whole, with every group.
+    let k0 = bounds
+        .iter()
+        .position(|b| b.0 >= from)
+        .unwrap_or(bounds.len());
+    let first_batch = if k0 > 0 { k0 + 1 } else { 0 };
     let mut begin = 0;
     let mut ahead: Vec<(usize, usize)> = Vec::new();
     for (k, jobs) in all_jobs.iter().enumerate() {
         let end = bounds[k].1;
+        if k < k0 || (k == k0 && k0 > 0) {
+            begin = end;
+            continue;
+        }
         for (j, job) in jobs.iter().enumerate() {
             if !(job.grounded && drops(&s, job, begin, end)) {
                 ahead.push((k, j));
@@ -225,7 +250,30 @@ pub fn analyze_steps_within(
     let mut begin = 0;
     let mut complete = true;
     for (k, jobs) in all_jobs.iter().enumerate() {
-        if k % STEPS_A_BATCH == 0 {
+        if k < k0 {
+            begin = bounds[k].1;
+            continue;
+        }
+        if k == k0 && k0 > 0 {
+            if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                complete = false;
+                break;
+            }
+            let (step, end) = bounds[k];
+            let whole = solve_all(&s, end, params)?;
+            solves += 1;
+            current[..end].copy_from_slice(&whole);
+            steps.push(check(step, &current[..end]));
+            begin = end;
+            if !steps[steps.len() - 1].stands {
+                first_failure = Some(step);
+                if stop_at_first_failure {
+                    break;
+                }
+            }
+            continue;
+        }
+        if k >= first_batch && (k - first_batch) % STEPS_A_BATCH == 0 {
             if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
                 complete = false;
                 break;

@@ -1,27 +1,35 @@
 //! The build's stability stage: check every step with the force analysis
 //! of [`crate::physics`], repair what fails, and report.
 //!
-//! `--stability repair` (the default) fixes weak spots in two ways, each
+//! `--stability repair` (the default) fixes weak spots in three ways, each
 //! checked again before it is kept:
-//! - **layout**: when the finished model itself would break or fall, the
-//!   search runs again with other seeds (another layout of the same
-//!   voxels) and the first layout that stands is kept;
 //! - **order**: when the finished model stands but a step before the end
 //!   does not, the pieces that fail are deferred until the structure holds
-//!   them ([`crate::physics::repair::reorder`]).
+//!   them ([`crate::physics::repair::reorder`]);
+//! - **supports**: where the model still fails, support columns of 1 x 1
+//!   pieces in a colour of their own go under what it cannot hold itself,
+//!   the finished model first, then each step that fails
+//!   ([`crate::physics::support::shore_up`]); `--no-supports` leaves them
+//!   out;
+//! - **layout**: when it still fails, the search runs again with other
+//!   seeds (another layout of the same voxels) and the layout that stands
+//!   longest is kept.
 //!
-//! `--stability check` reports and fails the build; `--stability off`
-//! skips the stage.
+//! What still fails is reported, with whether the build would stand on a
+//! baseplate. `--stability check` reports and fails the build;
+//! `--stability off` skips the stage.
 
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
 use crate::assembly::verify::verify;
-use crate::assembly::Assembly;
+use crate::assembly::{Assembly, Placement};
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
+use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
-    analyze, analyze_steps_within, Analysis, Ground, Params, PhysicsError, StepsAnalysis,
+    analyze, analyze_steps_from, analyze_steps_within, Analysis, Ground, Params, PhysicsError,
+    StepsAnalysis,
 };
 use crate::search::SearchOutcome;
 
@@ -125,6 +133,10 @@ pub struct StabilityReport {
     pub repairs: Vec<String>,
     /// Pieces the repair moved to a later step.
     pub moved: Vec<Moved>,
+    /// Support columns the repair added, in build order.
+    pub supports: Vec<Column>,
+    /// Pieces the support columns are made of.
+    pub support_pieces: usize,
     /// The seed of the layout kept, when the repair searched again.
     pub reseeded: Option<u64>,
     /// How the build stood before repairs, when it was repaired.
@@ -148,14 +160,16 @@ pub struct StabilityReport {
 /// assembly, with the name of its order.
 pub type Plan = (SearchOutcome, Assembly, &'static str);
 
-/// Runs the stage on `plan`. `replan(seed)` searches again with another
-/// seed. Returns the plan to write, possibly repaired, and the report.
+/// Runs the stage on `plan`. `supports`: the repair may add support
+/// columns. `replan(seed)` searches again with another seed. Returns the
+/// plan to write, possibly repaired, and the report.
 pub fn settle(
     mode: Stability,
     plan: Plan,
     seed: u64,
     params: &Params,
     budget: Duration,
+    supports: bool,
     replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
     let deadline = Instant::now() + budget;
@@ -174,6 +188,12 @@ pub fn settle(
     };
     let mut best = first;
     let mut reseeded = None;
+    let mut repairs = Vec::new();
+    // Support columns first: they keep the model's own layout.
+    let mut shored = Shoring::default();
+    if supports && mode == Stability::Repair && best.check.first_failure.is_some() {
+        shored = support(&mut best, params, deadline, &mut counts)?;
+    }
     if mode == Stability::Repair && best.check.first_failure.is_some() {
         // Other layouts of the same voxels; the first that stands at every
         // step (after its own order repair) is kept, else the best tried.
@@ -195,14 +215,12 @@ pub fn settle(
             if candidate.better_than(&best) {
                 best = candidate;
                 reseeded = Some(other);
+                shored = Shoring::default();
             }
             if best.check.first_failure.is_none() {
                 break;
             }
         }
-    }
-    let mut repairs = Vec::new();
-    if mode == Stability::Repair && before.first_failure.is_some() {
         if let Some(other) = reseeded {
             repairs.push(format!(
                 "layout: the search tried other layouts of the same voxels and kept seed {other}'s ({})",
@@ -217,15 +235,38 @@ pub fn settle(
                 "layout: none of {RESEEDS} other layouts of the same voxels did better"
             ));
         }
+    }
+    if mode == Stability::Repair && before.first_failure.is_some() {
         match (&best.order_fix, best.order_tried) {
             (Some(moved), _) => repairs.push(format!(
                 "order: {} pieces moved to later steps, where the structure holds them",
                 moved.len()
             )),
-            (None, Some(step)) => repairs.push(format!(
+            (None, Some(step)) if best.check.first_failure.is_some() => repairs.push(format!(
                 "order: step {step} would not stand, and deferring its weak pieces (at most {MAX_REPAIRED_STEP} pieces a step) did not help"
             )),
-            (None, None) => {}
+            _ => {}
+        }
+        if !shored.columns.is_empty() {
+            let color = best
+                .plan
+                .1
+                .pieces
+                .iter()
+                .find(|p| shored.pieces.contains(&p.placement))
+                .and_then(|p| p.color.spec())
+                .map_or("a colour of their own", |c| c.name);
+            repairs.push(format!(
+                "supports: {} columns of 1 x 1 pieces ({} pieces, {}) under what the model cannot hold itself{}",
+                shored.columns.len(),
+                shored.pieces.len(),
+                color.to_lowercase(),
+                if best.check.first_failure.is_none() {
+                    ""
+                } else {
+                    "; not enough to make every step stand"
+                }
+            ));
         }
     }
     let mut on_baseplate = None;
@@ -254,6 +295,7 @@ pub fn settle(
         &check,
         repairs,
         order_fix.unwrap_or_default(),
+        shored,
         reseeded,
         repaired.then_some(before),
         on_baseplate,
@@ -338,6 +380,101 @@ fn attempt(
     })
 }
 
+/// The support columns kept.
+#[derive(Default)]
+struct Shoring {
+    columns: Vec<Column>,
+    pieces: Vec<Placement>,
+}
+
+/// Adds support columns to `best` where it still fails: under the
+/// finished model first when it fails, then under each step that does,
+/// checking again after each round and keeping only what makes the build
+/// stand longer.
+fn support(
+    best: &mut Attempt,
+    params: &Params,
+    deadline: Instant,
+    counts: &mut Counts,
+) -> Result<Shoring, crate::pipeline::BuildError> {
+    let mut kept = Shoring::default();
+    let color = support_color(&best.plan.1);
+    while Instant::now() < deadline && kept.columns.len() < MAX_COLUMNS {
+        let target = if !best.check.last.stands() {
+            None
+        } else if let Some(step) = best.check.first_failure {
+            Some(step)
+        } else {
+            break;
+        };
+        let asm = &best.plan.1;
+        let Some(shored) = shore_up(
+            asm,
+            params,
+            target,
+            kept.columns.len(),
+            color,
+            Some(deadline),
+        )?
+        else {
+            break;
+        };
+        counts.solves += shored.solves;
+        // The model's voxels and the columns' cells: the cover to verify.
+        let mut cover = best.plan.0.voxels.clone();
+        for p in kept.pieces.iter().chain(&shored.pieces) {
+            cover.set_body(&p.body(asm.layer_ldu), true);
+        }
+        if !verify(&shored.assembly, Some(&cover)).is_ok() {
+            break;
+        }
+        // Steps before the first column stand as they did.
+        let from = shored
+            .assembly
+            .pieces
+            .iter()
+            .zip(&asm.pieces)
+            .find(|(a, b)| a != b)
+            .map_or(1, |(a, _)| a.step.0);
+        let c = analyze_steps_from(&shored.assembly, params, false, Some(deadline), from)?;
+        counts.add(&c);
+        let mut steps: Vec<_> = best
+            .check
+            .steps
+            .iter()
+            .filter(|s| s.step < from)
+            .cloned()
+            .collect();
+        let first_failure = steps
+            .iter()
+            .find(|s| !s.stands)
+            .map(|s| s.step)
+            .or(c.first_failure);
+        steps.extend(c.steps);
+        let candidate = Attempt {
+            plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
+            check: StepsAnalysis {
+                steps,
+                first_failure,
+                ..c
+            },
+            order_fix: best.order_fix.clone(),
+            order_tried: best.order_tried,
+        };
+        if !candidate.check.complete || !candidate.better_than(best) {
+            break;
+        }
+        *best = candidate;
+        kept.columns.extend(shored.columns);
+        kept.pieces.extend(shored.pieces);
+        if !shored.stands {
+            break;
+        }
+    }
+    steps_of(&best.plan.1, &mut kept.columns);
+    Ok(kept)
+}
+
 /// `a` fails later than `b` (`None`: never).
 fn later(a: Option<u32>, b: Option<u32>) -> bool {
     match (a, b) {
@@ -355,6 +492,7 @@ fn report(
     check: &StepsAnalysis,
     repairs: Vec<String>,
     moved: Vec<Moved>,
+    shored: Shoring,
     reseeded: Option<u64>,
     before: Option<Before>,
     stands_on_baseplate: Option<bool>,
@@ -382,6 +520,8 @@ fn report(
             .collect(),
         repairs,
         moved,
+        support_pieces: shored.pieces.len(),
+        supports: shored.columns,
         reseeded,
         before,
         stands_on_baseplate,

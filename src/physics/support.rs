@@ -1,0 +1,602 @@
+//! Support columns: what a build gets where no layout or order of its own
+//! pieces holds it.
+//!
+//! Some shapes cannot stand on their own pieces: a head on a thin neck
+//! whose weight is outside its footprint, a wing held by one course of
+//! studs. Builders of display models prop such parts with columns of
+//! plain bricks, often in a colour of their own. [`shore_up`] does the
+//! same, guided by the force model:
+//!
+//! 1. every cell under a piece's bottom that is empty all the way down to
+//!    the ground (or to the top of a piece built before it) is a
+//!    **candidate column**;
+//! 2. one linear program ([`solve_propped`]) lets every candidate push its
+//!    piece up, at a price per unit of force, while no stud joint may use
+//!    more than [`TARGET`] of its clutch: the candidates it leans on are
+//!    where support does the most good (a prop far out on an overhang
+//!    needs less force than one near its root, so the price picks it);
+//! 3. the columns carrying the most force become real pieces (1 x 1
+//!    bricks, topped with 1 x 1 plates where the grid is a plate high),
+//!    added in a step of their own just before the piece they hold;
+//! 4. the structure is analysed again, and the rounds repeat until it
+//!    stands or [`MAX_COLUMNS`] columns are in.
+//!
+//! Columns only fill cells no piece fills, so the model's own shape is
+//! unchanged; the caller verifies the result (connection, placeability)
+//! and checks every step again.
+
+use std::collections::{HashMap, HashSet};
+
+use serde::Serialize;
+
+use super::model::{solve_propped, Prop, Props, Structure};
+use super::{analyze, Params, PhysicsError};
+use crate::assembly::verify::{verify, Failure};
+use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS};
+use crate::catalog::{Color, PartKind};
+use crate::geom::{Body, Cell, Rot};
+
+/// The share of a stud's clutch capacity no joint may use once propped:
+/// a margin below breaking.
+pub const TARGET: f64 = 0.9;
+
+/// Columns a build gets at most; a build that needs more keeps what it has.
+pub const MAX_COLUMNS: usize = 48;
+
+/// Columns added in one round at most.
+const PER_ROUND: usize = 6;
+
+/// Plans a round may make at most, leaving out columns that cannot be put
+/// in place.
+const TRIES: usize = 4;
+
+/// Rounds of planning and checking at most.
+const ROUNDS: usize = 12;
+
+/// Price of a unit of prop force (clutch units), and more per layer of
+/// column: far below a hand's, far above a unit of clutch usage.
+const PROP_COST: f64 = 10.0;
+const PROP_COST_PER_LAYER: f64 = 0.5;
+
+/// A prop weaker than this share of the strongest one in a round is left
+/// for a later round.
+const KEEP_SHARE: f64 = 0.25;
+
+/// A support column.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Column {
+    /// Stud column.
+    pub x: i32,
+    /// Stud row.
+    pub y: i32,
+    /// Lowest layer it fills.
+    pub bottom: i32,
+    /// Highest layer it fills.
+    pub top: i32,
+    /// The step that adds it (its own, just before the step of the piece
+    /// it holds).
+    pub step: u32,
+    /// Whether it stands on the ground (else on a piece).
+    pub on_ground: bool,
+    /// Pieces it is made of.
+    pub pieces: usize,
+}
+
+/// A column that could go under a piece.
+#[derive(Debug, Clone)]
+struct Candidate {
+    /// The piece held up.
+    piece: usize,
+    x: i32,
+    y: i32,
+    bottom: i32,
+    lands_on: Option<usize>,
+}
+
+/// What [`shore_up`] did.
+#[derive(Debug, Clone)]
+pub struct Shored {
+    /// The assembly with its columns, steps renumbered.
+    pub assembly: Assembly,
+    /// The columns added, in build order.
+    pub columns: Vec<Column>,
+    /// The pieces the columns are made of.
+    pub pieces: Vec<Placement>,
+    /// The structure up to the step checked stands.
+    pub stands: bool,
+    /// Force analyses run.
+    pub solves: usize,
+}
+
+/// Adds support columns until the structure built by the end of step
+/// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
+/// (counting `already`) are in, or the deadline passes. Columns are made
+/// of 1 x 1 pieces in `color`. `None` when no column could be added.
+pub fn shore_up(
+    assembly: &Assembly,
+    params: &Params,
+    upto: Option<u32>,
+    already: usize,
+    color: Color,
+    deadline: Option<std::time::Instant>,
+) -> Result<Option<Shored>, PhysicsError> {
+    let mut asm = assembly.clone();
+    let mut upto = upto;
+    let mut columns: Vec<Column> = Vec::new();
+    let mut pieces: Vec<Placement> = Vec::new();
+    let mut solves = 0;
+    let mut stands = false;
+    let mut excluded: HashSet<(i32, i32, i32)> = HashSet::new();
+    for _ in 0..ROUNDS {
+        if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            break;
+        }
+        let end = match upto {
+            Some(s) => asm.pieces.iter().take_while(|p| p.step.0 <= s).count(),
+            None => asm.pieces.len(),
+        };
+        let prefix = Assembly {
+            pieces: asm.pieces[..end].to_vec(),
+            layer_ldu: asm.layer_ldu,
+        };
+        solves += 1;
+        if analyze(&prefix, params)?.stands() {
+            stands = true;
+            break;
+        }
+        let room = MAX_COLUMNS.saturating_sub(already + columns.len());
+        if room == 0 {
+            break;
+        }
+        // Columns that cannot be put in place (built pieces enclose them,
+        // or they would enclose a later piece) are planned again without.
+        let mut found = None;
+        for _ in 0..TRIES {
+            let chosen = plan(&asm, end, params, room.min(PER_ROUND), &excluded)?;
+            solves += 1;
+            if chosen.is_empty() {
+                break;
+            }
+            let (next, added, placed) = insert(&asm, &chosen, color);
+            let blocked = unplaceable(&next, &placed, &chosen);
+            if blocked.is_empty() {
+                found = Some((next, added, placed));
+                break;
+            }
+            excluded.extend(blocked);
+        }
+        let Some((next, added, placed)) = found else {
+            break;
+        };
+        if let Some(s) = upto.as_mut() {
+            // Every column comes before the piece it holds, in the prefix.
+            *s = next.pieces[end - 1 + placed.len()].step.0;
+        }
+        asm = next;
+        columns.extend(added);
+        pieces.extend(placed);
+    }
+    if columns.is_empty() {
+        return Ok(None);
+    }
+    steps_of(&asm, &mut columns);
+    Ok(Some(Shored {
+        assembly: asm,
+        columns,
+        pieces,
+        stands,
+        solves,
+    }))
+}
+
+/// The columns of `chosen` (as `(x, y, bottom)`) that make `asm` fail
+/// the verifier's connection or placeability rules: those whose pieces
+/// fail, and when a model piece fails instead, every column near it.
+fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Vec<(i32, i32, i32)> {
+    let column_pieces: HashSet<&Placement> = placed.iter().collect();
+    let mut out = Vec::new();
+    let report = verify(asm, None);
+    for f in &report.failures {
+        let (Failure::NotPlaceable { piece, .. } | Failure::NotConnected { piece, .. }) = *f else {
+            continue;
+        };
+        let p = &asm.pieces[piece].placement;
+        if column_pieces.contains(p) {
+            if let Some(c) = chosen
+                .iter()
+                .find(|c| c.x == p.origin.x && c.y == p.origin.y && c.bottom <= p.origin.z)
+            {
+                out.push((c.x, c.y, c.bottom));
+            }
+        } else {
+            let b = p.body(asm.layer_ldu).bbox;
+            out.extend(
+                chosen
+                    .iter()
+                    .filter(|c| {
+                        c.x >= b.min.x - 1
+                            && c.x <= b.min.x + b.sx
+                            && c.y >= b.min.y - 1
+                            && c.y <= b.min.y + b.sy
+                    })
+                    .map(|c| (c.x, c.y, c.bottom)),
+            );
+        }
+    }
+    if out.is_empty() && !report.is_ok() {
+        // Something else failed: none of this round's columns is safe.
+        out.extend(chosen.iter().map(|c| (c.x, c.y, c.bottom)));
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Layers a 1 x 1 brick and a 1 x 1 plate fill in a grid of `layer_ldu`
+/// layers (`None`: no whole number).
+fn layers(layer_ldu: i32, height_ldu: i32) -> Option<i32> {
+    (height_ldu % layer_ldu == 0).then_some(height_ldu / layer_ldu)
+}
+
+/// The 1 x 1 pieces that fill `h` layers, bottom up: bricks, then plates
+/// for the rest. `None` when the grid's layers cannot be filled.
+fn fill(layer_ldu: i32, h: i32) -> Option<Vec<(PartKind, i32)>> {
+    let brick = PartKind::from_id("3005")?;
+    let plate = PartKind::from_id("3024")?;
+    let lb = layers(layer_ldu, brick.spec().height_ldu())?;
+    let (n, rest) = (h / lb, h % lb);
+    let mut out: Vec<(PartKind, i32)> = (0..n).map(|_| (brick, lb)).collect();
+    if rest > 0 {
+        let lp = layers(layer_ldu, plate.spec().height_ldu())?;
+        if rest % lp != 0 {
+            return None;
+        }
+        out.extend((0..rest / lp).map(|_| (plate, lp)));
+    }
+    Some(out)
+}
+
+/// Every candidate column under the first `end` pieces.
+fn candidates(asm: &Assembly, bodies: &[Body], end: usize) -> Vec<Candidate> {
+    let mut owner: HashMap<Cell, usize> = HashMap::new();
+    for (i, b) in bodies.iter().enumerate() {
+        for c in b.cells() {
+            owner.insert(c, i);
+        }
+    }
+    let ground = bodies.iter().map(|b| b.bbox.min.z).min().unwrap_or(0);
+    // The first piece of each piece's step: a column must land on a piece
+    // built before that step.
+    let mut step_start = vec![0; asm.pieces.len()];
+    for i in 1..asm.pieces.len() {
+        step_start[i] = if asm.pieces[i].step == asm.pieces[i - 1].step {
+            step_start[i - 1]
+        } else {
+            i
+        };
+    }
+    let top = bodies
+        .iter()
+        .map(|b| b.bbox.max_excl().z)
+        .max()
+        .unwrap_or(0);
+    let mut out = Vec::new();
+    for (i, b) in bodies.iter().enumerate().take(end) {
+        let z = b.bbox.min.z;
+        if z == ground {
+            continue;
+        }
+        // A piece hung under one built before it is pressed on from below:
+        // a column under it would bar the way.
+        let hung = b.bbox.cells().filter(|c| c.z == z).any(|c| {
+            (b.bbox.max_excl().z..top)
+                .any(|zz| owner.get(&Cell::new(c.x, c.y, zz)).is_some_and(|&j| j < i))
+        });
+        if hung {
+            continue;
+        }
+        for c in b.tubes.cells() {
+            let mut zb = z - 1;
+            while zb >= ground && !owner.contains_key(&Cell::new(c.x, c.y, zb)) {
+                zb -= 1;
+            }
+            if zb == z - 1 {
+                continue;
+            }
+            let lands_on = if zb < ground {
+                None
+            } else {
+                let q = owner[&Cell::new(c.x, c.y, zb)];
+                if q >= step_start[i] || !bodies[q].studs.contains(Cell::new(c.x, c.y, zb)) {
+                    continue;
+                }
+                Some(q)
+            };
+            if fill(asm.layer_ldu, z - 1 - zb).is_none() {
+                continue;
+            }
+            out.push(Candidate {
+                piece: i,
+                x: c.x,
+                y: c.y,
+                bottom: zb + 1,
+                lands_on,
+            });
+        }
+    }
+    out
+}
+
+/// The columns the structure of the first `end` pieces leans on most, at
+/// most `max`, one a cell.
+fn plan(
+    asm: &Assembly,
+    end: usize,
+    params: &Params,
+    max: usize,
+    excluded: &HashSet<(i32, i32, i32)>,
+) -> Result<Vec<Candidate>, PhysicsError> {
+    let bodies: Vec<Body> = asm
+        .pieces
+        .iter()
+        .map(|p| p.placement.body(asm.layer_ldu))
+        .collect();
+    let mut all = candidates(asm, &bodies, end);
+    all.retain(|c| !excluded.contains(&(c.x, c.y, c.bottom)));
+    if all.is_empty() {
+        return Ok(Vec::new());
+    }
+    let prefix = Assembly {
+        pieces: asm.pieces[..end].to_vec(),
+        layer_ldu: asm.layer_ldu,
+    };
+    let s = Structure::new(&prefix, params);
+    let props: Vec<Prop> = all
+        .iter()
+        .map(|c| Prop {
+            piece: c.piece,
+            at: (f64::from(c.x) + 0.5, f64::from(c.y) + 0.5),
+            lands_on: c.lands_on,
+            cost: PROP_COST
+                + PROP_COST_PER_LAYER * f64::from(bodies[c.piece].bbox.min.z - c.bottom),
+        })
+        .collect();
+    let pieces: Vec<usize> = (0..end).collect();
+    let contacts: Vec<_> = s.contacts.iter().collect();
+    let solved = solve_propped(
+        &s,
+        &pieces,
+        &contacts,
+        params,
+        Some(&Props {
+            props: &props,
+            cap: TARGET,
+        }),
+    )?;
+    let strongest = solved.props.iter().copied().fold(0.0, f64::max);
+    if strongest < 1e-6 {
+        return Ok(Vec::new());
+    }
+    let mut order: Vec<usize> = (0..all.len()).collect();
+    order.sort_by(|&a, &b| solved.props[b].total_cmp(&solved.props[a]).then(a.cmp(&b)));
+    let mut chosen: Vec<Candidate> = Vec::new();
+    let mut cells: HashSet<(i32, i32)> = HashSet::new();
+    for k in order {
+        if chosen.len() >= max || solved.props[k] < KEEP_SHARE * strongest {
+            break;
+        }
+        let c = &all[k];
+        if cells.insert((c.x, c.y)) {
+            chosen.push(c.clone());
+        }
+    }
+    Ok(chosen)
+}
+
+/// `asm` with the `chosen` columns added, each in a step of its own just
+/// before the step of the piece it holds (columns holding pieces of one
+/// step share it; past [`MAX_STEPS`], they join that step instead).
+fn insert(
+    asm: &Assembly,
+    chosen: &[Candidate],
+    color: Color,
+) -> (Assembly, Vec<Column>, Vec<Placement>) {
+    let bodies_z: Vec<i32> = asm.pieces.iter().map(|p| p.placement.origin.z).collect();
+    // Columns by the step they hold up.
+    let mut by_step: std::collections::BTreeMap<u32, Vec<&Candidate>> = Default::default();
+    for c in chosen {
+        by_step
+            .entry(asm.pieces[c.piece].step.0)
+            .or_default()
+            .push(c);
+    }
+    let own_steps = asm.step_count() as usize + by_step.len() <= MAX_STEPS;
+    let mut pieces: Vec<Placed> = Vec::with_capacity(asm.pieces.len() + 4 * chosen.len());
+    let mut columns = Vec::new();
+    let mut placed = Vec::new();
+    let mut shift = 0;
+    let mut last_step = 0;
+    for p in &asm.pieces {
+        if p.step.0 != last_step {
+            last_step = p.step.0;
+            if let Some(cs) = by_step.get(&p.step.0) {
+                if own_steps {
+                    shift += 1;
+                }
+                for c in cs {
+                    let top = bodies_z[c.piece] - 1;
+                    let parts = fill(asm.layer_ldu, top + 1 - c.bottom).unwrap_or_default();
+                    let mut z = c.bottom;
+                    for &(part, h) in &parts {
+                        let placement = Placement::new(part, Cell::new(c.x, c.y, z), Rot::R0);
+                        pieces.push(Placed {
+                            placement,
+                            step: Step(p.step.0 + shift - u32::from(own_steps)),
+                            color,
+                        });
+                        placed.push(placement);
+                        z += h;
+                    }
+                    columns.push(Column {
+                        x: c.x,
+                        y: c.y,
+                        bottom: c.bottom,
+                        top,
+                        step: p.step.0 + shift - u32::from(own_steps),
+                        on_ground: c.lands_on.is_none(),
+                        pieces: parts.len(),
+                    });
+                }
+            }
+        }
+        pieces.push(Placed {
+            step: Step(p.step.0 + shift),
+            ..*p
+        });
+    }
+    (
+        Assembly {
+            pieces,
+            layer_ldu: asm.layer_ldu,
+        },
+        columns,
+        placed,
+    )
+}
+
+/// Sets each column's step from where its bottom piece is in `asm`
+/// (later rounds renumber the steps).
+pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
+    let at: HashMap<Cell, u32> = asm
+        .pieces
+        .iter()
+        .map(|p| (p.placement.origin, p.step.0))
+        .collect();
+    for c in columns {
+        if let Some(&s) = at.get(&Cell::new(c.x, c.y, c.bottom)) {
+            c.step = s;
+        }
+    }
+}
+
+/// A colour for support columns that none of `assembly`'s pieces has:
+/// light bluish grey, else dark bluish grey, black or white.
+pub fn support_color(assembly: &Assembly) -> Color {
+    let used: HashSet<Color> = assembly.pieces.iter().map(|p| p.color).collect();
+    [Color(71), Color(72), Color(0), Color(15)]
+        .into_iter()
+        .find(|c| !used.contains(c))
+        .unwrap_or(Color(71))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::analyze_steps;
+
+    fn piece(id: &str, x: i32, z: i32, step: u32) -> Placed {
+        Placed {
+            placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0),
+            step: Step(step),
+            color: Color::RED,
+        }
+    }
+
+    /// A post of three 1 x 1 bricks and a 1 x 6 arm on top reaching five
+    /// studs past it: on a table the post tips over.
+    fn gallows() -> Assembly {
+        Assembly {
+            pieces: vec![
+                piece("3005", 0, 0, 1),
+                piece("3005", 0, 1, 2),
+                piece("3005", 0, 2, 3),
+                piece("3009", 0, 3, 4),
+            ],
+            layer_ldu: 24,
+        }
+    }
+
+    #[test]
+    fn a_column_under_the_arm_makes_the_gallows_stand() {
+        let params = Params::default();
+        let asm = gallows();
+        assert!(!analyze(&asm, &params).unwrap().stands());
+        let shored = shore_up(&asm, &params, None, 0, Color(71), None)
+            .unwrap()
+            .expect("a column");
+        assert!(shored.stands);
+        assert!(analyze(&shored.assembly, &params).unwrap().stands());
+        let check = analyze_steps(&shored.assembly, &params, false).unwrap();
+        assert_eq!(check.first_failure, None, "{check:?}");
+        assert!(verify(&shored.assembly, None).is_ok());
+        // One column from the table up to the arm, away from the post, in a
+        // step of its own before the arm's.
+        assert_eq!(shored.columns.len(), 1);
+        let c = &shored.columns[0];
+        assert!(c.on_ground && c.bottom == 0 && c.top == 2, "{c:?}");
+        assert!((1..=5).contains(&c.x), "{c:?}");
+        assert_eq!(c.pieces, 3);
+        assert_eq!(shored.pieces.len(), 3);
+        let arm = shored
+            .assembly
+            .pieces
+            .iter()
+            .find(|p| p.placement.part.spec().id.0 == "3009")
+            .unwrap();
+        assert_eq!(c.step + 1, arm.step.0);
+        let steps: Vec<u32> = shored.assembly.pieces.iter().map(|p| p.step.0).collect();
+        assert_eq!(steps, [1, 2, 3, 4, 4, 4, 5]);
+        let support: Vec<&Placed> = shored
+            .assembly
+            .pieces
+            .iter()
+            .filter(|p| p.color == Color(71))
+            .collect();
+        assert_eq!(support.len(), 3);
+        // Nothing the model fills is taken.
+        let model: HashSet<Cell> = asm
+            .pieces
+            .iter()
+            .flat_map(|p| p.placement.body(24).cells().collect::<Vec<_>>())
+            .collect();
+        for p in support {
+            assert!(p.placement.body(24).cells().all(|c| !model.contains(&c)));
+        }
+        // The same input gives the same columns.
+        let again = shore_up(&asm, &params, None, 0, Color(71), None)
+            .unwrap()
+            .unwrap();
+        assert_eq!(again.assembly, shored.assembly);
+    }
+
+    #[test]
+    fn a_step_is_shored_up_with_columns_before_it_and_a_standing_build_is_left_alone() {
+        let params = Params::default();
+        let asm = gallows();
+        let shored = shore_up(&asm, &params, Some(4), 0, Color(71), None)
+            .unwrap()
+            .expect("a column");
+        assert!(shored.stands);
+        assert_eq!(shored.columns.len(), 1);
+        // Up to step 3 the post stands: nothing to do.
+        assert!(shore_up(&asm, &params, Some(3), 0, Color(71), None)
+            .unwrap()
+            .is_none());
+        // No room left for columns: nothing added.
+        assert!(shore_up(&asm, &params, None, MAX_COLUMNS, Color(71), None)
+            .unwrap()
+            .is_none());
+    }
+
+    #[test]
+    fn plate_grids_top_columns_with_plates() {
+        // Bricks are three layers of a plate grid: seven layers are two
+        // bricks and a plate.
+        let parts = fill(8, 7).unwrap();
+        let ids: Vec<&str> = parts.iter().map(|(p, _)| p.spec().id.0).collect();
+        assert_eq!(ids, ["3005", "3005", "3024"]);
+        // A slope grid (half bricks) has no piece for an odd layer.
+        assert!(fill(12, 3).is_none());
+        assert_eq!(fill(12, 4).unwrap().len(), 2);
+    }
+}
