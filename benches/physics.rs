@@ -9,9 +9,14 @@
 //! Measured (2 cores, Clarabel with QDLDL): 1,024 pieces in 0.13 s, 5,040
 //! in 0.61 s, every step of the 1,024-piece build in 0.10 s (every step
 //! but the last is certified without a solve: each brick rests straight
-//! on the ones below). A real model is slower: the 756-piece bunny of
-//! `build --studs 32` takes 0.5 s whole and 42 s step by step, since most
-//! of its steps add pieces that need clutch and are solved one by one.
+//! on the ones below).
+//!
+//! A real build is slower, since most of its steps add pieces that need
+//! clutch and are solved one by one: `steps/mug` checks every step of the
+//! search's build of `fixtures/mug.obj` at 32 studs, and `support/arch`
+//! plans and checks the support columns of `fixtures/arch.obj` at 24
+//! studs (the search leaves one leg's voxels out, so its span hangs from
+//! the other leg) until it stands.
 //!
 //! ```text
 //! cargo bench --bench physics
@@ -20,10 +25,35 @@
 
 use criterion::{criterion_main, BenchmarkId, Criterion};
 
+use std::path::Path;
+
+use brickwright::assembly::order::by_course;
+use brickwright::assembly::{Assembly, StepGrouping};
+use brickwright::catalog::Color;
+use brickwright::physics::support::shore_up;
 use brickwright::physics::{analyze, analyze_steps, Params};
+use brickwright::search::{self, SearchOptions};
+use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
 
 mod common;
 use common::block;
+
+/// The search's build of a fixture mesh, sequenced and grouped as `build`
+/// does it.
+fn fixture_build(name: &str, studs: u32) -> Assembly {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name);
+    let mesh = brickwright::mesh::load(&path).expect("fixture loads");
+    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
+    let grid = voxelize(&mesh, &opts).expect("fixture voxelizes").grid;
+    let rules = brickwright::pipeline::load_rules(None).expect("the default rules load");
+    let outcome = search::build(&grid, &rules, &SearchOptions::default()).expect("a build");
+    let order = search::placements(&outcome);
+    let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
+    a.regroup(StepGrouping::Auto);
+    a
+}
 
 fn bench(c: &mut Criterion) {
     let params = Params::default();
@@ -39,6 +69,20 @@ fn bench(c: &mut Criterion) {
     let a = block(16, 32);
     group.bench_function(BenchmarkId::new("steps", a.pieces.len()), |b| {
         b.iter(|| analyze_steps(&a, &params, false).expect("solves"))
+    });
+    let mug = fixture_build("mug.obj", 32);
+    group.bench_function(BenchmarkId::new("steps/mug", mug.pieces.len()), |b| {
+        b.iter(|| analyze_steps(&mug, &params, false).expect("solves"))
+    });
+    let arch = fixture_build("arch.obj", 24);
+    group.bench_function(BenchmarkId::new("support/arch", arch.pieces.len()), |b| {
+        b.iter(|| {
+            let shored = shore_up(&arch, &params, None, 0, Color(71), None)
+                .expect("solves")
+                .expect("columns");
+            assert!(shored.stands);
+            shored
+        })
     });
     group.finish();
 }

@@ -151,13 +151,13 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
         pieces_in_columns += c["pieces"].as_u64().unwrap();
     }
     assert_eq!(st["support_pieces"].as_u64(), Some(pieces_in_columns));
-    // The columns' bricks: light bluish grey (71) 1 x 1s, all before the arm.
+    // The columns' bricks: light bluish grey (71), all before the arm.
     let support_lines: Vec<usize> = lines
         .iter()
         .enumerate()
         .filter(|(_, l)| l.first() == Some(&"1") && l[1] == "71")
         .map(|(i, l)| {
-            assert_eq!(l.last(), Some(&"3005.dat"));
+            assert!(["3003.dat", "3004.dat", "3005.dat"].contains(l.last().unwrap()));
             i
         })
         .collect();

@@ -15,9 +15,10 @@
 //!    more than [`TARGET`] of its clutch: the candidates it leans on are
 //!    where support does the most good (a prop far out on an overhang
 //!    needs less force than one near its root, so the price picks it);
-//! 3. the columns carrying the most force become real pieces (1 x 1
-//!    bricks, topped with 1 x 1 plates where the grid is a plate high),
-//!    added in a step of their own just before the piece they hold;
+//! 3. the columns carrying the most force become real pieces: bricks
+//!    (topped with plates where the grid is a plate high) 2 x 2 where
+//!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in a step of their
+//!    own just before the piece they hold;
 //! 4. the structure is analysed again, and the rounds repeat until it
 //!    stands or [`MAX_COLUMNS`] columns are in.
 //!
@@ -65,10 +66,13 @@ const KEEP_SHARE: f64 = 0.25;
 /// A support column.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Column {
-    /// Stud column.
+    /// Stud column of its minimum corner.
     pub x: i32,
-    /// Stud row.
+    /// Stud row of its minimum corner.
     pub y: i32,
+    /// Its footprint in studs: 2 x 2 where there is room, else 2 x 1,
+    /// 1 x 2 or 1 x 1.
+    pub size: [i32; 2],
     /// Lowest layer it fills.
     pub bottom: i32,
     /// Highest layer it fills.
@@ -87,10 +91,32 @@ pub struct Column {
 struct Candidate {
     /// The piece held up.
     piece: usize,
+    /// The cell under the piece where the column pushes it up.
     x: i32,
     y: i32,
+    /// The column's footprint: minimum corner and size.
+    foot: (i32, i32, i32, i32),
     bottom: i32,
     lands_on: Option<usize>,
+}
+
+impl Candidate {
+    /// Whether the column's footprint covers stud `(x, y)`.
+    fn covers(&self, x: i32, y: i32) -> bool {
+        let (x0, y0, sx, sy) = self.foot;
+        x >= x0 && x < x0 + sx && y >= y0 && y < y0 + sy
+    }
+
+    /// The studs of its footprint.
+    fn studs(&self) -> impl Iterator<Item = (i32, i32)> {
+        let (x0, y0, sx, sy) = self.foot;
+        (y0..y0 + sy).flat_map(move |y| (x0..x0 + sx).map(move |x| (x, y)))
+    }
+
+    /// Its key among excluded columns.
+    fn key(&self) -> (i32, i32, i32) {
+        (self.x, self.y, self.bottom)
+    }
 }
 
 /// What [`shore_up`] did.
@@ -111,7 +137,7 @@ pub struct Shored {
 /// Adds support columns until the structure built by the end of step
 /// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
 /// (counting `already`) are in, or the deadline passes. Columns are made
-/// of 1 x 1 pieces in `color`. `None` when no column could be added.
+/// of pieces in `color`. `None` when no column could be added.
 pub fn shore_up(
     assembly: &Assembly,
     params: &Params,
@@ -204,9 +230,9 @@ fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Ve
         if column_pieces.contains(p) {
             if let Some(c) = chosen
                 .iter()
-                .find(|c| c.x == p.origin.x && c.y == p.origin.y && c.bottom <= p.origin.z)
+                .find(|c| c.covers(p.origin.x, p.origin.y) && c.bottom <= p.origin.z)
             {
-                out.push((c.x, c.y, c.bottom));
+                out.push(c.key());
             }
         } else {
             let b = p.body(asm.layer_ldu).bbox;
@@ -214,47 +240,65 @@ fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Ve
                 chosen
                     .iter()
                     .filter(|c| {
-                        c.x >= b.min.x - 1
-                            && c.x <= b.min.x + b.sx
-                            && c.y >= b.min.y - 1
-                            && c.y <= b.min.y + b.sy
+                        c.studs().any(|(x, y)| {
+                            x >= b.min.x - 1
+                                && x <= b.min.x + b.sx
+                                && y >= b.min.y - 1
+                                && y <= b.min.y + b.sy
+                        })
                     })
-                    .map(|c| (c.x, c.y, c.bottom)),
+                    .map(Candidate::key),
             );
         }
     }
     if out.is_empty() && !report.is_ok() {
         // Something else failed: none of this round's columns is safe.
-        out.extend(chosen.iter().map(|c| (c.x, c.y, c.bottom)));
+        out.extend(chosen.iter().map(Candidate::key));
     }
     out.sort_unstable();
     out.dedup();
     out
 }
 
-/// Layers a 1 x 1 brick and a 1 x 1 plate fill in a grid of `layer_ldu`
+/// Layers a piece `height_ldu` high fills in a grid of `layer_ldu`
 /// layers (`None`: no whole number).
 fn layers(layer_ldu: i32, height_ldu: i32) -> Option<i32> {
     (height_ldu % layer_ldu == 0).then_some(height_ldu / layer_ldu)
 }
 
-/// The 1 x 1 pieces that fill `h` layers, bottom up: bricks, then plates
-/// for the rest. `None` when the grid's layers cannot be filled.
-fn fill(layer_ldu: i32, h: i32) -> Option<Vec<(PartKind, i32)>> {
-    let brick = PartKind::from_id("3005")?;
-    let plate = PartKind::from_id("3024")?;
+/// The pieces of footprint `sx` x `sy` that fill `h` layers, bottom up:
+/// bricks, then plates for the rest, each with its turn and layers.
+/// `None` when the grid's layers cannot be filled.
+fn fill(layer_ldu: i32, h: i32, sx: i32, sy: i32) -> Option<Vec<(PartKind, Rot, i32)>> {
+    let (brick, plate) = match (sx.max(sy), sx.min(sy)) {
+        (1, 1) => ("3005", "3024"),
+        (2, 1) => ("3004", "3023b"),
+        (2, 2) => ("3003", "3022"),
+        _ => return None,
+    };
+    let brick = PartKind::from_id(brick)?;
+    let plate = PartKind::from_id(plate)?;
+    let rot = if brick.spec().footprint(Rot::R0) == (sx, sy) {
+        Rot::R0
+    } else {
+        Rot::R90
+    };
     let lb = layers(layer_ldu, brick.spec().height_ldu())?;
     let (n, rest) = (h / lb, h % lb);
-    let mut out: Vec<(PartKind, i32)> = (0..n).map(|_| (brick, lb)).collect();
+    let mut out: Vec<(PartKind, Rot, i32)> = (0..n).map(|_| (brick, rot, lb)).collect();
     if rest > 0 {
         let lp = layers(layer_ldu, plate.spec().height_ldu())?;
         if rest % lp != 0 {
             return None;
         }
-        out.extend((0..rest / lp).map(|_| (plate, lp)));
+        out.extend((0..rest / lp).map(|_| (plate, rot, lp)));
     }
     Some(out)
 }
+
+/// Footprints a column may take, widest first: a wider column stands
+/// firmer and holds with more studs.
+const SIZES: [(i32, i32); 4] = [(2, 2), (2, 1), (1, 2), (1, 1)];
 
 /// Every candidate column under the first `end` pieces.
 fn candidates(asm: &Assembly, bodies: &[Body], end: usize) -> Vec<Candidate> {
@@ -280,45 +324,91 @@ fn candidates(asm: &Assembly, bodies: &[Body], end: usize) -> Vec<Candidate> {
         .map(|b| b.bbox.max_excl().z)
         .max()
         .unwrap_or(0);
+    // A piece hung under one built before it is pressed on from below: a
+    // column under it would bar the way.
+    let hung: Vec<bool> = bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let z = b.bbox.min.z;
+            b.bbox.cells().filter(|c| c.z == z).any(|c| {
+                (b.bbox.max_excl().z..top)
+                    .any(|zz| owner.get(&Cell::new(c.x, c.y, zz)).is_some_and(|&j| j < i))
+            })
+        })
+        .collect();
+    // Columns stay within the model's footprint box (and so within its
+    // voxel grid).
+    let (lo, hi) = bodies.iter().fold(
+        ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN)),
+        |((x0, y0), (x1, y1)), b| {
+            let m = b.bbox.max_excl();
+            (
+                (x0.min(b.bbox.min.x), y0.min(b.bbox.min.y)),
+                (x1.max(m.x), y1.max(m.y)),
+            )
+        },
+    );
+    let free = |x: i32, y: i32, z: i32| {
+        x >= lo.0 && x < hi.0 && y >= lo.1 && y < hi.1 && !owner.contains_key(&Cell::new(x, y, z))
+    };
     let mut out = Vec::new();
     for (i, b) in bodies.iter().enumerate().take(end) {
         let z = b.bbox.min.z;
-        if z == ground {
-            continue;
-        }
-        // A piece hung under one built before it is pressed on from below:
-        // a column under it would bar the way.
-        let hung = b.bbox.cells().filter(|c| c.z == z).any(|c| {
-            (b.bbox.max_excl().z..top)
-                .any(|zz| owner.get(&Cell::new(c.x, c.y, zz)).is_some_and(|&j| j < i))
-        });
-        if hung {
+        if z == ground || hung[i] {
             continue;
         }
         for c in b.tubes.cells() {
             let mut zb = z - 1;
-            while zb >= ground && !owner.contains_key(&Cell::new(c.x, c.y, zb)) {
+            while zb >= ground && free(c.x, c.y, zb) {
                 zb -= 1;
             }
             if zb == z - 1 {
                 continue;
             }
-            let lands_on = if zb < ground {
-                None
-            } else {
-                let q = owner[&Cell::new(c.x, c.y, zb)];
-                if q >= step_start[i] || !bodies[q].studs.contains(Cell::new(c.x, c.y, zb)) {
-                    continue;
+            // What a stud of the footprint stands on: the ground, or the
+            // stud of a piece built before this one's step.
+            let base = |x: i32, y: i32| -> Option<Option<usize>> {
+                if zb < ground {
+                    return Some(None);
                 }
-                Some(q)
+                let q = *owner.get(&Cell::new(x, y, zb))?;
+                (q < step_start[i] && bodies[q].studs.contains(Cell::new(x, y, zb)))
+                    .then_some(Some(q))
             };
-            if fill(asm.layer_ldu, z - 1 - zb).is_none() {
+            let Some(lands_on) = base(c.x, c.y) else {
                 continue;
-            }
+            };
+            // The widest footprint around the cell whose every stud is free
+            // from the base up to the piece's layer, stands on the same
+            // base, and tops out under this piece, under nothing, or under
+            // a later piece that is not hung.
+            let fits = |x0: i32, y0: i32, sx: i32, sy: i32| {
+                fill(asm.layer_ldu, z - 1 - zb, sx, sy).is_some()
+                    && (y0..y0 + sy).all(|y| {
+                        (x0..x0 + sx).all(|x| {
+                            (zb + 1..z).all(|zz| free(x, y, zz))
+                                && base(x, y).is_some_and(|q| q.is_some() == lands_on.is_some())
+                                && owner
+                                    .get(&Cell::new(x, y, z))
+                                    .is_none_or(|&j| j == i || (j >= step_start[i] && !hung[j]))
+                        })
+                    })
+            };
+            let foot = SIZES.iter().find_map(|&(sx, sy)| {
+                (0..sy)
+                    .flat_map(|dy| (0..sx).map(move |dx| (c.x - dx, c.y - dy)))
+                    .find(|&(x0, y0)| fits(x0, y0, sx, sy))
+                    .map(|(x0, y0)| (x0, y0, sx, sy))
+            });
+            let Some(foot) = foot else {
+                continue;
+            };
             out.push(Candidate {
                 piece: i,
                 x: c.x,
                 y: c.y,
+                foot,
                 bottom: zb + 1,
                 lands_on,
             });
@@ -342,7 +432,7 @@ fn plan(
         .map(|p| p.placement.body(asm.layer_ldu))
         .collect();
     let mut all = candidates(asm, &bodies, end);
-    all.retain(|c| !excluded.contains(&(c.x, c.y, c.bottom)));
+    all.retain(|c| !excluded.contains(&c.key()));
     if all.is_empty() {
         return Ok(Vec::new());
     }
@@ -386,7 +476,8 @@ fn plan(
             break;
         }
         let c = &all[k];
-        if cells.insert((c.x, c.y)) {
+        if c.studs().all(|at| !cells.contains(&at)) {
+            cells.extend(c.studs());
             chosen.push(c.clone());
         }
     }
@@ -425,10 +516,11 @@ fn insert(
                 }
                 for c in cs {
                     let top = bodies_z[c.piece] - 1;
-                    let parts = fill(asm.layer_ldu, top + 1 - c.bottom).unwrap_or_default();
+                    let (x0, y0, sx, sy) = c.foot;
+                    let parts = fill(asm.layer_ldu, top + 1 - c.bottom, sx, sy).unwrap_or_default();
                     let mut z = c.bottom;
-                    for &(part, h) in &parts {
-                        let placement = Placement::new(part, Cell::new(c.x, c.y, z), Rot::R0);
+                    for &(part, rot, h) in &parts {
+                        let placement = Placement::new(part, Cell::new(x0, y0, z), rot);
                         pieces.push(Placed {
                             placement,
                             step: Step(p.step.0 + shift - u32::from(own_steps)),
@@ -438,8 +530,9 @@ fn insert(
                         z += h;
                     }
                     columns.push(Column {
-                        x: c.x,
-                        y: c.y,
+                        x: x0,
+                        y: y0,
+                        size: [sx, sy],
                         bottom: c.bottom,
                         top,
                         step: p.step.0 + shift - u32::from(own_steps),
@@ -535,6 +628,9 @@ mod tests {
         let c = &shored.columns[0];
         assert!(c.on_ground && c.bottom == 0 && c.top == 2, "{c:?}");
         assert!((1..=5).contains(&c.x), "{c:?}");
+        // The widest that stays within the model's footprint: two studs
+        // along the arm (which is one stud deep).
+        assert_eq!(c.size, [2, 1], "{c:?}");
         assert_eq!(c.pieces, 3);
         assert_eq!(shored.pieces.len(), 3);
         let arm = shored
@@ -553,6 +649,9 @@ mod tests {
             .filter(|p| p.color == Color(71))
             .collect();
         assert_eq!(support.len(), 3);
+        assert!(support
+            .iter()
+            .all(|p| p.placement.part.spec().id.0 == "3004"));
         // Nothing the model fills is taken.
         let model: HashSet<Cell> = asm
             .pieces
@@ -592,11 +691,17 @@ mod tests {
     fn plate_grids_top_columns_with_plates() {
         // Bricks are three layers of a plate grid: seven layers are two
         // bricks and a plate.
-        let parts = fill(8, 7).unwrap();
-        let ids: Vec<&str> = parts.iter().map(|(p, _)| p.spec().id.0).collect();
+        let parts = fill(8, 7, 1, 1).unwrap();
+        let ids: Vec<&str> = parts.iter().map(|(p, _, _)| p.spec().id.0).collect();
         assert_eq!(ids, ["3005", "3005", "3024"]);
+        let parts = fill(8, 4, 2, 2).unwrap();
+        let ids: Vec<&str> = parts.iter().map(|(p, _, _)| p.spec().id.0).collect();
+        assert_eq!(ids, ["3003", "3022"]);
+        // A 1 x 2 footprint is a 2 x 1 brick turned a quarter.
+        let (part, rot, _) = fill(24, 1, 1, 2).unwrap()[0];
+        assert_eq!(part.spec().footprint(rot), (1, 2));
         // A slope grid (half bricks) has no piece for an odd layer.
-        assert!(fill(12, 3).is_none());
-        assert_eq!(fill(12, 4).unwrap().len(), 2);
+        assert!(fill(12, 3, 1, 1).is_none());
+        assert_eq!(fill(12, 4, 2, 1).unwrap().len(), 2);
     }
 }

@@ -6,8 +6,9 @@
 //! - **order**: when the finished model stands but a step before the end
 //!   does not, the pieces that fail are deferred until the structure holds
 //!   them ([`crate::physics::repair::reorder`]);
-//! - **supports**: where the model still fails, support columns of 1 x 1
-//!   pieces in a colour of their own go under what it cannot hold itself,
+//! - **supports**: where the model still fails, support columns (2 x 2
+//!   where there is room, else narrower) in a colour of their own go under
+//!   what it cannot hold itself,
 //!   the finished model first, then each step that fails
 //!   ([`crate::physics::support::shore_up`]); `--no-supports` leaves them
 //!   out;
@@ -257,8 +258,9 @@ pub fn settle(
                 .and_then(|p| p.color.spec())
                 .map_or("a colour of their own", |c| c.name);
             repairs.push(format!(
-                "supports: {} columns of 1 x 1 pieces ({} pieces, {}) under what the model cannot hold itself{}",
+                "supports: {} columns ({}; {} pieces, {}) under what the model cannot hold itself{}",
                 shored.columns.len(),
+                sizes(&shored.columns),
                 shored.pieces.len(),
                 color.to_lowercase(),
                 if best.check.first_failure.is_none() {
@@ -380,6 +382,20 @@ fn attempt(
     })
 }
 
+/// The columns' footprints in words: "3 of 2 x 2, 1 of 1 x 1".
+fn sizes(columns: &[Column]) -> String {
+    let mut counts: std::collections::BTreeMap<std::cmp::Reverse<[i32; 2]>, usize> =
+        Default::default();
+    for c in columns {
+        *counts.entry(std::cmp::Reverse(c.size)).or_default() += 1;
+    }
+    counts
+        .iter()
+        .map(|(std::cmp::Reverse([x, y]), n)| format!("{n} of {x} x {y}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The support columns kept.
 #[derive(Default)]
 struct Shoring {
@@ -422,8 +438,17 @@ fn support(
         counts.solves += shored.solves;
         // The model's voxels and the columns' cells: the cover to verify.
         let mut cover = best.plan.0.voxels.clone();
-        for p in kept.pieces.iter().chain(&shored.pieces) {
-            cover.set_body(&p.body(asm.layer_ldu), true);
+        let bodies: Vec<_> = kept
+            .pieces
+            .iter()
+            .chain(&shored.pieces)
+            .map(|p| p.body(asm.layer_ldu))
+            .collect();
+        if !bodies.iter().all(|b| b.cells().all(|c| cover.in_bounds(c))) {
+            break;
+        }
+        for b in &bodies {
+            cover.set_body(b, true);
         }
         if !verify(&shored.assembly, Some(&cover)).is_ok() {
             break;
