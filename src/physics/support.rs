@@ -558,18 +558,19 @@ fn insert(
 }
 
 /// Sets each column's step from where its bottom piece is in `asm`
-/// (later rounds renumber the steps).
+/// (later rounds renumber the steps), and puts them in build order.
 pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
     let at: HashMap<Cell, u32> = asm
         .pieces
         .iter()
         .map(|p| (p.placement.origin, p.step.0))
         .collect();
-    for c in columns {
+    for c in columns.iter_mut() {
         if let Some(&s) = at.get(&Cell::new(c.x, c.y, c.bottom)) {
             c.step = s;
         }
     }
+    columns.sort_by_key(|c| (c.step, c.bottom, c.y, c.x));
 }
 
 /// A colour for support columns that none of `assembly`'s pieces has:

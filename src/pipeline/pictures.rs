@@ -186,7 +186,9 @@ pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::
 }
 
 /// The finished model with each piece coloured by the share of its clutch
-/// capacity used: green none, yellow half, red all (or falls).
+/// capacity used: green none, yellow half, red all (or falls). It is seen
+/// from the quarter turn of the default view that shows the most of the
+/// weakest pieces (see [`stress_turns`]).
 pub fn stress_image(
     assembly: &Assembly,
     analysis: &crate::physics::Analysis,
@@ -196,7 +198,156 @@ pub fn stress_image(
         .iter()
         .map(|p| render::stress_color(if p.falls { f64::INFINITY } else { p.usage }))
         .collect();
-    let mut img = render::model_image_with_colors(assembly, &colors, &options())?;
+    let view = render::View::default().turned(stress_turns(assembly, analysis)?);
+    let mut img = render::model_image_with_colors(assembly, &colors, &options().with_view(view))?;
     render::draw_stress_legend(&mut img);
     Ok(img)
+}
+
+/// Pieces that count as the weakest, for choosing the stress picture's
+/// view: those that fail, and those using at least this share of the
+/// highest usage.
+const WEAK_SHARE: f64 = 0.5;
+
+/// Below this highest usage nothing is weak enough to turn the view for.
+const WEAK_MIN: f64 = 0.05;
+
+/// The quarter turns (0 to 3) of the default view that show the most of
+/// the model's weakest pieces (see [`weak_pixels`]); the default view
+/// keeps ties, and a model with no weak piece.
+pub fn stress_turns(
+    assembly: &Assembly,
+    analysis: &crate::physics::Analysis,
+) -> Result<u8, RenderError> {
+    let Some(counts) = weak_pixels(assembly, analysis)? else {
+        return Ok(0);
+    };
+    let best = (0..4)
+        .max_by_key(|&k| (counts[k], std::cmp::Reverse(k)))
+        .unwrap_or(0);
+    Ok(best as u8)
+}
+
+/// How many pixels of the weakest pieces each quarter turn of the default
+/// view shows: each view drawn small, the weakest pieces in one colour and
+/// the rest in another. `None` when no piece is weak.
+fn weak_pixels(
+    assembly: &Assembly,
+    analysis: &crate::physics::Analysis,
+) -> Result<Option<[usize; 4]>, RenderError> {
+    let top = analysis.max_usage;
+    let weak: Vec<bool> = analysis
+        .pieces
+        .iter()
+        .map(|p| p.fails() || (top >= WEAK_MIN && p.usage >= WEAK_SHARE * top))
+        .collect();
+    if !weak.contains(&true) {
+        return Ok(None);
+    }
+    const MARK: image::Rgb<u8> = image::Rgb([255, 0, 255]);
+    let colors: Vec<_> = weak
+        .iter()
+        .map(|&w| if w { MARK } else { image::Rgb([255, 255, 255]) })
+        .collect();
+    let counts: Vec<usize> = (0..4u8)
+        .into_par_iter()
+        .map(|k| {
+            let opts = options()
+                .with_size(320, 240)
+                .with_view(render::View::default().turned(k));
+            render::model_image_with_colors(assembly, &colors, &opts).map(|img| {
+                // The mark's hue, whatever its shading.
+                img.pixels()
+                    .filter(|p| p[0] > p[1].saturating_add(60) && p[2] > p[1].saturating_add(60))
+                    .count()
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Some([counts[0], counts[1], counts[2], counts[3]]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{Placed, Placement, Step};
+    use crate::geom::{Cell, Rot};
+    use crate::physics::{analyze, Params};
+
+    fn piece(id: &str, x: i32, y: i32, z: i32, rot: Rot) -> Placed {
+        Placed {
+            placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, y, z), rot),
+            step: Step(1),
+            color: Color::RED,
+        }
+    }
+
+    /// A cantilever (a 2 x 8 arm on a 2 x 2 column, which tips it: the
+    /// only failing pieces) in the middle of a 20 x 20 stud yard, and a
+    /// wall twelve bricks high along one side of the yard: `side` 0 to 3.
+    fn yard(side: u8) -> Assembly {
+        let mut pieces = Vec::new();
+        for z in 0..4 {
+            pieces.push(piece("3003", 7, 7, z, Rot::R0));
+        }
+        pieces.push(piece("3007", 7, 7, 4, Rot::R0));
+        for z in 0..12 {
+            for k in 0..5 {
+                let (x, y, rot) = match side {
+                    0 => (k * 4, 0, Rot::R0),
+                    1 => (k * 4, 19, Rot::R0),
+                    2 => (0, k * 4, Rot::R90),
+                    _ => (19, k * 4, Rot::R90),
+                };
+                pieces.push(piece("3010", x, y, z, rot));
+            }
+        }
+        Assembly {
+            pieces,
+            layer_ldu: 24,
+        }
+    }
+
+    #[test]
+    fn the_stress_picture_turns_to_show_the_weakest_pieces() {
+        let params = Params::default();
+        let mut turns = Vec::new();
+        for side in 0..4 {
+            let asm = yard(side);
+            let a = analyze(&asm, &params).unwrap();
+            // The arm tips its column; the walls stand.
+            assert!(a.pieces[..5].iter().any(|p| p.fails()), "{a:?}");
+            assert!(a.pieces[5..].iter().all(|p| !p.fails()), "{a:?}");
+            turns.push(stress_turns(&asm, &a).unwrap());
+        }
+        // The view goes round the wall: it does not stay put.
+        let mut distinct = turns.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert!(distinct.len() >= 2, "{turns:?}");
+        // Where the wall hides the arm from the default view, the chosen
+        // view shows it plainly.
+        let mut hidden = 0;
+        for side in 0..4 {
+            let asm = yard(side);
+            let a = analyze(&asm, &params).unwrap();
+            let counts = weak_pixels(&asm, &a).unwrap().unwrap();
+            let chosen = counts[turns[side as usize] as usize];
+            assert!(chosen > 300, "{counts:?}");
+            if counts[0] * 3 < chosen {
+                hidden += 1;
+                assert_ne!(turns[side as usize], 0);
+            }
+        }
+        assert!(
+            hidden >= 1,
+            "the wall hid the arm from the default view somewhere"
+        );
+        // A model with nothing weak keeps the default view.
+        let calm = Assembly {
+            pieces: vec![piece("3001", 0, 0, 0, Rot::R0)],
+            layer_ldu: 24,
+        };
+        let a = analyze(&calm, &params).unwrap();
+        assert_eq!(stress_turns(&calm, &a).unwrap(), 0);
+    }
 }
