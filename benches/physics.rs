@@ -29,7 +29,7 @@ use std::path::Path;
 
 use brickwright::assembly::order::by_course;
 use brickwright::assembly::{Assembly, StepGrouping};
-use brickwright::catalog::Color;
+use brickwright::catalog::{Color, Family};
 use brickwright::physics::support::shore_up;
 use brickwright::physics::{analyze, analyze_steps, Params};
 use brickwright::search::{self, SearchOptions};
@@ -38,17 +38,27 @@ use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
 mod common;
 use common::block;
 
-/// The search's build of a fixture mesh, sequenced and grouped as `build`
-/// does it.
+/// The search's build of a fixture mesh, searched, sequenced and grouped
+/// as `build` does it.
 fn fixture_build(name: &str, studs: u32) -> Assembly {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures")
         .join(name);
     let mesh = brickwright::mesh::load(&path).expect("fixture loads");
     let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
-    let grid = voxelize(&mesh, &opts).expect("fixture voxelizes").grid;
-    let rules = brickwright::pipeline::load_rules(None).expect("the default rules load");
-    let outcome = search::build(&grid, &rules, &SearchOptions::default()).expect("a build");
+    let model = voxelize(&mesh, &opts).expect("fixture voxelizes");
+    // Bricks only, as `build` has it without --plates or --slopes.
+    let rules = brickwright::pipeline::load_rules(None)
+        .expect("the default rules load")
+        .restricted(|p| p.spec().family() == Family::Brick)
+        .expect("brick rules");
+    let outcome = search::build_guided(
+        &model.grid,
+        Some(&model.slant),
+        &rules,
+        &SearchOptions::default(),
+    )
+    .expect("a build");
     let order = search::placements(&outcome);
     let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
     a.regroup(StepGrouping::Auto);
@@ -75,9 +85,12 @@ fn bench(c: &mut Criterion) {
         b.iter(|| analyze_steps(&mug, &params, false).expect("solves"))
     });
     let arch = fixture_build("arch.obj", 24);
+    let fails = analyze_steps(&arch, &params, false)
+        .expect("solves")
+        .first_failure;
     group.bench_function(BenchmarkId::new("support/arch", arch.pieces.len()), |b| {
         b.iter(|| {
-            let shored = shore_up(&arch, &params, None, 0, Color(71), None)
+            let shored = shore_up(&arch, &params, fails, 0, Color(71), None)
                 .expect("solves")
                 .expect("columns");
             assert!(shored.stands);
