@@ -356,9 +356,9 @@ pub struct BuildReport {
     pub voxels_input: usize,
     /// Voxels built (after repairs).
     pub voxels: usize,
-    /// Pieces in all.
+    /// Pieces in all (support columns included).
     pub pieces: usize,
-    /// Mean voxels per piece.
+    /// Mean voxels per piece of the model (support columns left out).
     pub voxels_per_piece: f64,
     /// Vertical seams and how many continue into the course above.
     pub seams: crate::assembly::metrics::SeamStats,
@@ -687,7 +687,15 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         voxels_input: model.grid.count(),
         voxels,
         pieces,
-        voxels_per_piece: ((voxels as f64 / pieces.max(1) as f64) * 100.0).round() / 100.0,
+        // The model's own pieces: support columns fill no voxel of it.
+        voxels_per_piece: {
+            let own = pieces
+                - stability
+                    .as_ref()
+                    .map_or(0, |(r, _)| r.support_pieces)
+                    .min(pieces);
+            ((voxels as f64 / own.max(1) as f64) * 100.0).round() / 100.0
+        },
         seams: crate::assembly::metrics::seams(&assembly),
         parts: parts.rows(),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),

@@ -189,6 +189,11 @@ fn checking_from_a_later_step_agrees_with_checking_every_step() {
         );
         assert_eq!(part.last.pieces, all.last.pieces);
     }
+    // Past the last step: the last step is checked, whole.
+    let past = analyze_steps_from(&asm, &params, false, None, 9).unwrap();
+    assert_eq!(past.steps.len(), 1);
+    assert_eq!(past.steps[0].step, 7);
+    assert!(past.steps[0].stands);
 }
 
 /// A 1x4 base on a table, a 1x6 overhang clutched to its last stud

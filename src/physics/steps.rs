@@ -217,15 +217,21 @@ pub fn analyze_steps_from(
     // Every step's groups, and whether each needs a solve if everything
     // before stood (the common case): those programs are solved up front,
     // all steps in parallel.
-    let mut all_jobs: Vec<Vec<Job>> = Vec::with_capacity(bounds.len());
-    for &(_, end) in &bounds {
-        all_jobs.push(jobs_for_step(&s, &mut g, &mut next, end, &mut reused));
-    }
-    // The first step checked: solved whole, with every group.
+    // The first step checked (the last one when `from` is past it): solved
+    // whole, with every group.
     let k0 = bounds
         .iter()
         .position(|b| b.0 >= from)
-        .unwrap_or(bounds.len());
+        .unwrap_or(bounds.len().saturating_sub(1));
+    let mut all_jobs: Vec<Vec<Job>> = Vec::with_capacity(bounds.len());
+    for (k, &(_, end)) in bounds.iter().enumerate() {
+        let before = reused;
+        all_jobs.push(jobs_for_step(&s, &mut g, &mut next, end, &mut reused));
+        if k0 > 0 && k <= k0 {
+            // Skipped, or solved whole: nothing of it is reused.
+            reused = before;
+        }
+    }
     let first_batch = if k0 > 0 { k0 + 1 } else { 0 };
     let mut begin = 0;
     let mut ahead: Vec<(usize, usize)> = Vec::new();

@@ -10,7 +10,7 @@
 //! 1. every cell under a piece's bottom that is empty all the way down to
 //!    the ground (or to the top of a piece built before it) is a
 //!    **candidate column**;
-//! 2. one linear program ([`solve_propped`]) lets every candidate push its
+//! 2. one linear program (`model::solve_propped`) lets every candidate push its
 //!    piece up, at a price per unit of force, while no stud joint may use
 //!    more than [`TARGET`] of its clutch: the candidates it leans on are
 //!    where support does the most good (a prop far out on an overhang
@@ -20,7 +20,8 @@
 //!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in a step of their
 //!    own just before the piece they hold;
 //! 4. the structure is analysed again, and the rounds repeat until it
-//!    stands or [`MAX_COLUMNS`] columns are in.
+//!    stands, or [`MAX_COLUMNS`] columns are in, or 12 rounds have run, or
+//!    the deadline passes.
 //!
 //! Columns only fill cells no piece fills, so the model's own shape is
 //! unchanged; the caller verifies the result (connection, placeability)
@@ -114,10 +115,14 @@ impl Candidate {
     }
 
     /// Its key among excluded columns.
-    fn key(&self) -> (i32, i32, i32) {
-        (self.x, self.y, self.bottom)
+    fn key(&self) -> Footprint {
+        let (x0, y0, sx, sy) = self.foot;
+        (x0, y0, sx, sy, self.bottom)
     }
 }
+
+/// A column's footprint and bottom layer: `(x0, y0, sx, sy, bottom)`.
+type Footprint = (i32, i32, i32, i32, i32);
 
 /// What [`shore_up`] did.
 #[derive(Debug, Clone)]
@@ -152,8 +157,9 @@ pub fn shore_up(
     let mut pieces: Vec<Placement> = Vec::new();
     let mut solves = 0;
     let mut stands = false;
-    let mut excluded: HashSet<(i32, i32, i32)> = HashSet::new();
-    for _ in 0..ROUNDS {
+    let mut excluded: HashSet<Footprint> = HashSet::new();
+    // The last round only checks the columns the one before added.
+    for round in 0..=ROUNDS {
         if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
             break;
         }
@@ -171,7 +177,7 @@ pub fn shore_up(
             break;
         }
         let room = MAX_COLUMNS.saturating_sub(already + columns.len());
-        if room == 0 {
+        if room == 0 || round == ROUNDS {
             break;
         }
         // Columns that cannot be put in place (built pieces enclose them,
@@ -218,37 +224,47 @@ pub fn shore_up(
 /// The columns of `chosen` (as `(x, y, bottom)`) that make `asm` fail
 /// the verifier's connection or placeability rules: those whose pieces
 /// fail, and when a model piece fails instead, every column near it.
-fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Vec<(i32, i32, i32)> {
+fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Vec<Footprint> {
     let column_pieces: HashSet<&Placement> = placed.iter().collect();
+    // The column a piece of `asm` belongs to, if any.
+    let column_of = |piece: usize| {
+        let p = &asm.pieces[piece].placement;
+        if !column_pieces.contains(p) {
+            return None;
+        }
+        chosen
+            .iter()
+            .find(|c| c.covers(p.origin.x, p.origin.y) && c.bottom <= p.origin.z)
+    };
     let mut out = Vec::new();
     let report = verify(asm, None);
     for f in &report.failures {
-        let (Failure::NotPlaceable { piece, .. } | Failure::NotConnected { piece, .. }) = *f else {
-            continue;
-        };
-        let p = &asm.pieces[piece].placement;
-        if column_pieces.contains(p) {
-            if let Some(c) = chosen
-                .iter()
-                .find(|c| c.covers(p.origin.x, p.origin.y) && c.bottom <= p.origin.z)
-            {
-                out.push(c.key());
+        match *f {
+            Failure::Overlap { a, b, .. } => {
+                out.extend([a, b].into_iter().filter_map(column_of).map(Candidate::key));
             }
-        } else {
-            let b = p.body(asm.layer_ldu).bbox;
-            out.extend(
-                chosen
-                    .iter()
-                    .filter(|c| {
-                        c.studs().any(|(x, y)| {
-                            x >= b.min.x - 1
-                                && x <= b.min.x + b.sx
-                                && y >= b.min.y - 1
-                                && y <= b.min.y + b.sy
+            Failure::NotPlaceable { piece, .. } | Failure::NotConnected { piece, .. } => {
+                if let Some(c) = column_of(piece) {
+                    out.push(c.key());
+                    continue;
+                }
+                // A model piece the columns enclose: blame those beside it.
+                let b = asm.pieces[piece].placement.body(asm.layer_ldu).bbox;
+                out.extend(
+                    chosen
+                        .iter()
+                        .filter(|c| {
+                            c.studs().any(|(x, y)| {
+                                x >= b.min.x - 1
+                                    && x <= b.min.x + b.sx
+                                    && y >= b.min.y - 1
+                                    && y <= b.min.y + b.sy
+                            })
                         })
-                    })
-                    .map(Candidate::key),
-            );
+                        .map(Candidate::key),
+                );
+            }
+            _ => {}
         }
     }
     if out.is_empty() && !report.is_ok() {
@@ -301,10 +317,17 @@ fn fill(layer_ldu: i32, h: i32, sx: i32, sy: i32) -> Option<Vec<(PartKind, Rot, 
 const SIZES: [(i32, i32); 4] = [(2, 2), (2, 1), (1, 2), (1, 1)];
 
 /// Every candidate column under the first `end` pieces.
-fn candidates(asm: &Assembly, bodies: &[Body], end: usize) -> Vec<Candidate> {
+fn candidates(
+    asm: &Assembly,
+    bodies: &[Body],
+    end: usize,
+    excluded: &HashSet<Footprint>,
+) -> Vec<Candidate> {
     let mut owner: HashMap<Cell, usize> = HashMap::new();
+    // The verifier counts a piece's whole bounding box as taken (a slope's
+    // open front included): so do the columns.
     for (i, b) in bodies.iter().enumerate() {
-        for c in b.cells() {
+        for c in b.bbox.cells() {
             owner.insert(c, i);
         }
     }
@@ -398,7 +421,9 @@ fn candidates(asm: &Assembly, bodies: &[Body], end: usize) -> Vec<Candidate> {
             let foot = SIZES.iter().find_map(|&(sx, sy)| {
                 (0..sy)
                     .flat_map(|dy| (0..sx).map(move |dx| (c.x - dx, c.y - dy)))
-                    .find(|&(x0, y0)| fits(x0, y0, sx, sy))
+                    .find(|&(x0, y0)| {
+                        !excluded.contains(&(x0, y0, sx, sy, zb + 1)) && fits(x0, y0, sx, sy)
+                    })
                     .map(|(x0, y0)| (x0, y0, sx, sy))
             });
             let Some(foot) = foot else {
@@ -424,15 +449,14 @@ fn plan(
     end: usize,
     params: &Params,
     max: usize,
-    excluded: &HashSet<(i32, i32, i32)>,
+    excluded: &HashSet<Footprint>,
 ) -> Result<Vec<Candidate>, PhysicsError> {
     let bodies: Vec<Body> = asm
         .pieces
         .iter()
         .map(|p| p.placement.body(asm.layer_ldu))
         .collect();
-    let mut all = candidates(asm, &bodies, end);
-    all.retain(|c| !excluded.contains(&c.key()));
+    let all = candidates(asm, &bodies, end, excluded);
     if all.is_empty() {
         return Ok(Vec::new());
     }
@@ -484,8 +508,8 @@ fn plan(
     Ok(chosen)
 }
 
-/// `asm` with the `chosen` columns added, each in a step of its own just
-/// before the step of the piece it holds (columns holding pieces of one
+/// `asm` with the `chosen` columns added in a step of their own just
+/// before the step of the pieces they hold (columns holding pieces of one
 /// step share it; past [`MAX_STEPS`], they join that step instead).
 fn insert(
     asm: &Assembly,
@@ -506,10 +530,10 @@ fn insert(
     let mut columns = Vec::new();
     let mut placed = Vec::new();
     let mut shift = 0;
-    let mut last_step = 0;
+    let mut last_step = None;
     for p in &asm.pieces {
-        if p.step.0 != last_step {
-            last_step = p.step.0;
+        if last_step != Some(p.step.0) {
+            last_step = Some(p.step.0);
             if let Some(cs) = by_step.get(&p.step.0) {
                 if own_steps {
                     shift += 1;

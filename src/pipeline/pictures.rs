@@ -213,7 +213,7 @@ const WEAK_SHARE: f64 = 0.5;
 const WEAK_MIN: f64 = 0.05;
 
 /// The quarter turns (0 to 3) of the default view that show the most of
-/// the model's weakest pieces (see [`weak_pixels`]); the default view
+/// the model's weakest pieces (see `weak_pixels`); the default view
 /// keeps ties, and a model with no weak piece.
 pub fn stress_turns(
     assembly: &Assembly,

@@ -8,10 +8,9 @@
 //!   them ([`crate::physics::repair::reorder`]);
 //! - **supports**: where the model still fails, support columns (2 x 2
 //!   where there is room, else narrower) in a colour of their own go under
-//!   what it cannot hold itself,
-//!   the finished model first, then each step that fails
-//!   ([`crate::physics::support::shore_up`]); `--no-supports` leaves them
-//!   out;
+//!   what it cannot hold itself, the finished model first, then each step
+//!   that fails ([`crate::physics::support::shore_up`]); `--no-supports`
+//!   leaves them out;
 //! - **layout**: when it still fails, the search runs again with other
 //!   seeds (another layout of the same voxels) and the layout that stands
 //!   longest is kept.
@@ -328,20 +327,31 @@ struct Attempt {
     order_fix: Option<Vec<Moved>>,
     /// The step the order repair tried and could not fix.
     order_tried: Option<u32>,
+    /// The support columns' pieces in it.
+    supports: Vec<Placement>,
 }
 
 impl Attempt {
-    /// Stands at more steps: the finished model first, then a later first
-    /// failure, then a higher lowest score.
+    /// Stands at more steps: the finished model first, then more of the
+    /// model's own pieces built before the first failure (counted in
+    /// pieces, not steps: support columns add steps), then a higher lowest
+    /// score.
     fn better_than(&self, other: &Attempt) -> bool {
-        let key = |a: &Attempt| {
-            (
-                a.check.last.stands(),
-                a.check.first_failure.map_or(u32::MAX, |s| s),
-                a.check.last.min_score,
-            )
-        };
+        let key = |a: &Attempt| (a.check.last.stands(), a.progress(), a.check.last.min_score);
         key(self).partial_cmp(&key(other)) == Some(std::cmp::Ordering::Greater)
+    }
+
+    /// The model's own pieces (not support columns) in the steps before
+    /// the first failure; all of them when none fails.
+    fn progress(&self) -> usize {
+        let supports: std::collections::HashSet<&Placement> = self.supports.iter().collect();
+        let fails = self.check.first_failure.unwrap_or(u32::MAX);
+        self.plan
+            .1
+            .pieces
+            .iter()
+            .filter(|p| p.step.0 < fails && !supports.contains(&p.placement))
+            .count()
     }
 }
 
@@ -379,6 +389,7 @@ fn attempt(
         check,
         order_fix,
         order_tried,
+        supports: Vec::new(),
     })
 }
 
@@ -476,6 +487,16 @@ fn support(
             .map(|s| s.step)
             .or(c.first_failure);
         steps.extend(c.steps);
+        let supports: Vec<Placement> = best
+            .supports
+            .iter()
+            .chain(&shored.pieces)
+            .copied()
+            .collect();
+        let order_fix = best
+            .order_fix
+            .as_ref()
+            .map(|m| renumbered(m, asm, &shored.assembly, &supports));
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: StepsAnalysis {
@@ -483,8 +504,9 @@ fn support(
                 first_failure,
                 ..c
             },
-            order_fix: best.order_fix.clone(),
+            order_fix,
             order_tried: best.order_tried,
+            supports,
         };
         if !candidate.check.complete || !candidate.better_than(best) {
             break;
@@ -498,6 +520,35 @@ fn support(
     }
     steps_of(&best.plan.1, &mut kept.columns);
     Ok(kept)
+}
+
+/// `moved` with its target steps as numbered in `after`, which is `before`
+/// with support columns (`supports`) added.
+fn renumbered(
+    moved: &[Moved],
+    before: &Assembly,
+    after: &Assembly,
+    supports: &[Placement],
+) -> Vec<Moved> {
+    let supports: std::collections::HashSet<&Placement> = supports.iter().collect();
+    let mut step_map = std::collections::HashMap::new();
+    let own = |a: &'_ Assembly| {
+        a.pieces
+            .iter()
+            .filter(|p| !supports.contains(&p.placement))
+            .map(|p| p.step.0)
+            .collect::<Vec<_>>()
+    };
+    for (old, new) in own(before).into_iter().zip(own(after)) {
+        step_map.entry(old).or_insert(new);
+    }
+    moved
+        .iter()
+        .map(|m| Moved {
+            to_step: step_map.get(&m.to_step).copied().unwrap_or(m.to_step),
+            ..m.clone()
+        })
+        .collect()
 }
 
 /// `a` fails later than `b` (`None`: never).
