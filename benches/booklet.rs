@@ -35,6 +35,7 @@ fn bench(c: &mut Criterion) {
             title: "block",
             size_studs: [size, size, f64::from(courses)],
             size_cm: [size * 0.8, size * 0.8, f64::from(courses) * 0.96],
+            step_notes: Default::default(),
         };
         group.bench_function(BenchmarkId::new("pieces", n), |b| {
             b.iter(|| {

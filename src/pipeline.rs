@@ -80,6 +80,9 @@ pub struct BuildOptions {
     pub supports: bool,
 }
 
+/// The booklet's note on a step that adds a support column.
+pub const SUPPORT_NOTE: &str = "Support column: not part of the shape; it holds the model up";
+
 /// Default time for the stability stage: two minutes.
 pub const DEFAULT_STABILITY_BUDGET: std::time::Duration = std::time::Duration::from_secs(120);
 
@@ -598,6 +601,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                     f64::from(nz * rules.layer_ldu()) / 24.0,
                 ],
                 size_cm,
+                step_notes: stability
+                    .iter()
+                    .flat_map(|(r, _)| &r.supports)
+                    .map(|c| (c.step, SUPPORT_NOTE.to_string()))
+                    .collect(),
             };
             let rendered = pictures::render_all(&pictures, wants_steps)?;
             times.render = secs(t);

@@ -14,6 +14,9 @@ use brickwright::booklet::Template;
 use brickwright::pipeline::{self, BuildOptions, BuildOutput, Formats, Silent};
 use brickwright::voxel::Sizing;
 
+mod common;
+use common::tool;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -24,19 +27,6 @@ fn build(fixture: &str, out: &Path, configure: impl FnOnce(&mut BuildOptions)) -
     opts.sizing = Sizing::Studs(10);
     configure(&mut opts);
     pipeline::build(&opts, &Silent).unwrap_or_else(|e| panic!("{fixture} does not build: {e}"))
-}
-
-/// Whether the tool is there; a note when it is missing outside CI.
-fn tool(name: &str, package: &str) -> bool {
-    if Command::new(name).arg("-v").output().is_ok() {
-        return true;
-    }
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "{name} is missing, and CI=true: .ci/run installs {package}"
-    );
-    eprintln!("skipped: {name} is missing (apt-get install {package})");
-    false
 }
 
 fn run(cmd: &str, args: &[&str]) -> String {

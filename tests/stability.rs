@@ -16,6 +16,9 @@ use brickwright::physics::repair::reorder;
 use brickwright::physics::{analyze_steps, Params};
 use serde_json::Value;
 
+mod common;
+use common::tool;
+
 /// A gallows: a post one stud square and four bricks high, and an arm
 /// seven studs long on top, all one stud deep. On a table the post tips
 /// over as soon as the arm is on (the arm's weight is far past the post's
@@ -116,7 +119,7 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
         "-o",
         s(&out),
         "--formats",
-        "ldr,stress",
+        "ldr,stress,pdf",
     ]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
@@ -174,6 +177,15 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
         .unwrap()
         .to_rgba8();
     assert_eq!(red_pixels(&img), 0, "no red on the model");
+    // The booklet says what the column's step is for.
+    if tool("pdftotext", "poppler-utils") {
+        let text = Command::new("pdftotext")
+            .args([s(&out.join("gallows.pdf")), "-"])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&text.stdout);
+        assert!(text.contains(brickwright::pipeline::SUPPORT_NOTE), "{text}");
+    }
 }
 
 #[test]

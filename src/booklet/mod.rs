@@ -58,6 +58,9 @@ pub struct BookletInput<'a> {
     pub steps: &'a [RgbaImage],
     /// A picture of each part in each colour the build uses.
     pub parts: &'a BTreeMap<(PartKind, Color), RgbaImage>,
+    /// A short note under a step's parts, by step number (a support
+    /// column's step says what it is for).
+    pub step_notes: &'a BTreeMap<u32, String>,
 }
 
 /// How much of a page a step takes.
@@ -638,7 +641,12 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
                     &label,
                 );
             }
-            let top = y + box_h.max(ns * 0.3528) + 3.0;
+            let mut top = y + box_h.max(ns * 0.3528) + 3.0;
+            if let Some(note) = input.step_notes.get(&step) {
+                top += ts * 0.3528;
+                page.text(&fonts, x + 1.0, top, (ts, false, text), note);
+                top += 2.0;
+            }
             let img = images.add(&input.steps[step as usize - 1]);
             page.image_at(&img, x + 1.0, top, sw - 2.0, y + sh - top - 2.0, true);
         }
@@ -756,6 +764,7 @@ mod tests {
             exploded: &exploded,
             steps: &steps,
             parts: &parts,
+            step_notes: &BTreeMap::from([(2, "Support column".to_string())]),
         };
         let mut pdf = Vec::new();
         write_booklet(&mut pdf, &input, template).unwrap();

@@ -29,6 +29,8 @@ pub struct Pictures<'a> {
     pub size_studs: [f64; 3],
     /// Size in centimetres.
     pub size_cm: [f64; 3],
+    /// A short note for some steps, by step number, for the booklet.
+    pub step_notes: BTreeMap<u32, String>,
 }
 
 /// Rendered images, ready to be written.
@@ -179,6 +181,7 @@ pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::
         exploded: &r.exploded,
         steps: &r.steps,
         parts: &parts,
+        step_notes: &p.step_notes,
     };
     let mut pdf = Vec::new();
     write_booklet(&mut pdf, &input, template)?;
