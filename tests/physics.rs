@@ -119,23 +119,25 @@ fn a_cantilever_holds_at_a_short_reach_and_breaks_at_a_long_one() {
     assert!(long.pieces[2].usage < 1e-4);
 }
 
+/// Two 1x2 columns two bricks high at x 0..2 and 16..18 on a table, a 1x8
+/// arm on each reaching for the middle (one stud on its column), and a
+/// 1x4 keystone across the arms' ends; `steps` are the seven pieces'
+/// steps. Each half's centre of mass, (2 * 0.80 * 1 + 2.92 * 5) / 4.52 =
+/// 3.58, lies past its column's edge at x = 2, so an arm alone tips its
+/// column over; the keystone joins the halves into a symmetric bridge
+/// whose centre is between the columns.
+fn bridge(steps: [u32; 7]) -> Assembly {
+    let at = [(0, 0), (0, 1), (16, 0), (16, 1), (1, 2), (9, 2), (7, 3)];
+    let parts = ["3004", "3004", "3004", "3004", "3008", "3008", "3010"];
+    let pieces: Vec<P> = (0..7)
+        .map(|i| (parts[i], at[i].0, 0, at[i].1, R0, steps[i]))
+        .collect();
+    build(&pieces)
+}
+
 #[test]
 fn a_bridge_stands_only_once_its_keystone_is_in() {
-    // Two 1x2 columns two bricks high at x 0..2 and 16..18 on a table, a
-    // 1x8 arm on each reaching for the middle (one stud on its column):
-    // each half's centre of mass, (2 * 0.80 * 1 + 2.92 * 5) / 4.52 = 3.58,
-    // lies past its column's edge at x = 2, so an arm alone tips its column
-    // over. A 1x4 keystone across the arms' ends joins the halves into a
-    // symmetric bridge whose centre is between the columns.
-    let asm = build(&[
-        ("3004", 0, 0, 0, R0, 1),
-        ("3004", 0, 0, 1, R0, 1),
-        ("3004", 16, 0, 0, R0, 2),
-        ("3004", 16, 0, 1, R0, 2),
-        ("3008", 1, 0, 2, R0, 3),
-        ("3008", 9, 0, 2, R0, 4),
-        ("3010", 7, 0, 3, R0, 5),
-    ]);
+    let asm = bridge([1, 1, 2, 2, 3, 4, 5]);
     let params = Params::default();
     let steps = analyze_steps(&asm, &params, false).unwrap();
     let stands: Vec<bool> = steps.steps.iter().map(|s| s.stands).collect();
@@ -158,15 +160,7 @@ fn a_bridge_stands_only_once_its_keystone_is_in() {
 fn checking_from_a_later_step_agrees_with_checking_every_step() {
     // The bridge again, one piece a step: steps before `from` are taken as
     // standing; the rest must read exactly as a check from step 1 does.
-    let asm = build(&[
-        ("3004", 0, 0, 0, R0, 1),
-        ("3004", 0, 0, 1, R0, 2),
-        ("3004", 16, 0, 0, R0, 3),
-        ("3004", 16, 0, 1, R0, 4),
-        ("3008", 1, 0, 2, R0, 5),
-        ("3008", 9, 0, 2, R0, 6),
-        ("3010", 7, 0, 3, R0, 7),
-    ]);
+    let asm = bridge([1, 2, 3, 4, 5, 6, 7]);
     let params = Params::default();
     let all = analyze_steps(&asm, &params, false).unwrap();
     assert_eq!(all.first_failure, Some(5));

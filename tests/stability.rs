@@ -65,6 +65,16 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// Builds the gallows at 7 studs into `tmp/out` with `extra` options;
+/// the run and the output directory.
+fn build_gallows(tmp: &Path, extra: &[&str]) -> (std::process::Output, PathBuf) {
+    let mesh = write_gallows(tmp);
+    let out = tmp.join("out");
+    let mut args = vec!["build", s(&mesh), "--studs", "7", "-o", s(&out)];
+    args.extend_from_slice(extra);
+    (brickwright(&args), out)
+}
+
 fn report(out: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
 }
@@ -72,18 +82,7 @@ fn report(out: &Path) -> Value {
 #[test]
 fn check_refuses_a_build_that_tips_over_with_one_line_and_no_files() {
     let tmp = tempfile::tempdir().unwrap();
-    let mesh = write_gallows(tmp.path());
-    let out = tmp.path().join("out");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
-        "7",
-        "-o",
-        s(&out),
-        "--stability",
-        "check",
-    ]);
+    let (run, out) = build_gallows(tmp.path(), &["--stability", "check"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
@@ -109,18 +108,7 @@ fn red_pixels(img: &image::RgbaImage) -> usize {
 #[test]
 fn repair_props_the_gallows_arm_with_a_support_column() {
     let tmp = tempfile::tempdir().unwrap();
-    let mesh = write_gallows(tmp.path());
-    let out = tmp.path().join("out");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
-        "7",
-        "-o",
-        s(&out),
-        "--formats",
-        "ldr,stress,pdf",
-    ]);
+    let (run, out) = build_gallows(tmp.path(), &["--formats", "ldr,stress,pdf"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
     assert!(stdout.contains("repaired supports: "), "{stdout}");
@@ -191,19 +179,7 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
 #[test]
 fn repair_without_supports_reports_what_it_could_not_fix_and_draws_the_stress() {
     let tmp = tempfile::tempdir().unwrap();
-    let mesh = write_gallows(tmp.path());
-    let out = tmp.path().join("out");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
-        "7",
-        "-o",
-        s(&out),
-        "--formats",
-        "ldr,stress",
-        "--no-supports",
-    ]);
+    let (run, out) = build_gallows(tmp.path(), &["--formats", "ldr,stress", "--no-supports"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
     assert!(stdout.contains("warning: at step"), "{stdout}");
