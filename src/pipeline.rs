@@ -575,6 +575,12 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         }
     };
 
+    // What the booklet and the `.ldr` say of a support column's step.
+    let step_notes: std::collections::BTreeMap<u32, String> = stability
+        .iter()
+        .flat_map(|(r, _)| &r.supports)
+        .map(|c| (c.step, SUPPORT_NOTE.to_string()))
+        .collect();
     let stem = opts
         .input
         .file_stem()
@@ -601,11 +607,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                     f64::from(nz * rules.layer_ldu()) / 24.0,
                 ],
                 size_cm,
-                step_notes: stability
-                    .iter()
-                    .flat_map(|(r, _)| &r.supports)
-                    .map(|c| (c.step, SUPPORT_NOTE.to_string()))
-                    .collect(),
+                step_notes: step_notes.clone(),
             };
             let rendered = pictures::render_all(&pictures, wants_steps)?;
             times.render = secs(t);
@@ -655,6 +657,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             format!("options: {}", describe(opts)),
             format!("seed: {}", opts.search.seed),
         ],
+        step_notes,
     };
     let parts = PartsList::of(&assembly);
     let pieces = assembly.pieces.len();

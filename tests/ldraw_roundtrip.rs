@@ -16,6 +16,7 @@ fn meta(name: &str) -> LdrMeta {
         name: name.into(),
         author: "brickwright tests".into(),
         notes: vec!["brickwright 0.1.0".into(), "seed 7".into()],
+        step_notes: Default::default(),
     }
 }
 
@@ -149,6 +150,7 @@ fn golden_small_ldr() {
             "brickwright golden test".into(),
             "hand-made: two 2x4s, a 1x4, a 2x2".into(),
         ],
+        step_notes: Default::default(),
     };
     write_ldr(&mut out, &golden_assembly(), &meta).unwrap();
     let text = String::from_utf8(out).unwrap();

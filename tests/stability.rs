@@ -153,6 +153,11 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
         })
         .collect();
     assert_eq!(support_lines.len() as u64, pieces_in_columns);
+    // The column's step opens with a comment saying what it is for.
+    assert_eq!(
+        ldr.lines().nth(support_lines[0] - 1),
+        Some(format!("0 // {}", brickwright::pipeline::SUPPORT_NOTE).as_str())
+    );
     assert!(support_lines.iter().all(|&i| i < arm_line), "{ldr}");
     // Any checker agrees: the written model stands.
     let verified = brickwright(&["verify", "--stability", s(&out.join("gallows.ldr"))]);

@@ -70,6 +70,7 @@
 //!     name: "two.ldr".into(),
 //!     author: "brickwright".into(),
 //!     notes: vec![],
+//!     step_notes: Default::default(),
 //! };
 //! let mut out = Vec::new();
 //! write_ldr(&mut out, &asm, &meta).unwrap();

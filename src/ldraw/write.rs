@@ -23,6 +23,9 @@ pub struct LdrMeta {
     /// Extra comment lines (`0 // ...`): tool version, input file, options,
     /// seed.
     pub notes: Vec<String>,
+    /// A comment line (`0 // ...`) at the start of a step, by step number:
+    /// what the step is for (a support column, say).
+    pub step_notes: std::collections::BTreeMap<u32, String>,
 }
 
 /// Writes `asm` as an LDraw `.ldr` model to `w`.
@@ -39,6 +42,10 @@ pub fn write_ldr(w: &mut dyn Write, asm: &Assembly, meta: &LdrMeta) -> io::Resul
         header_line(w, "// ", note)?;
     }
     for (i, piece) in asm.pieces.iter().enumerate() {
+        let starts = i == 0 || asm.pieces[i - 1].step != piece.step;
+        if let Some(note) = meta.step_notes.get(&piece.step.0).filter(|_| starts) {
+            header_line(w, "// ", note)?;
+        }
         let p = &piece.placement;
         let [x, y, z] = placement_position(p, asm.layer_ldu);
         let m = rot_matrix(p.rot);
@@ -102,12 +109,34 @@ mod tests {
     }
 
     #[test]
+    fn a_step_note_opens_its_step() {
+        let brick = PartKind::from_id("3005").unwrap();
+        let order = [
+            Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+            Placement::new(brick, Cell::new(0, 0, 1), Rot::R0),
+        ];
+        let asm = Assembly::from_order(&order, 24, Color::RED);
+        let meta = LdrMeta {
+            step_notes: [(2, "a\nnote".to_string())].into(),
+            ..LdrMeta::default()
+        };
+        let text = write(&asm, &meta);
+        let kinds: Vec<&str> = text.lines().map(|l| l.get(..4).unwrap_or(l)).collect();
+        assert_eq!(
+            kinds,
+            ["0", "0 Na", "0 Au", "1 4 ", "0 ST", "0 //", "1 4 ", "0 ST"]
+        );
+        assert!(text.contains("0 // a note\n1 4 10 -48 10"), "{text}");
+    }
+
+    #[test]
     fn header_texts_cannot_inject_lines() {
         let meta = LdrMeta {
             title: "evil\n1 4 0 0 0 1 0 0 0 1 0 0 0 1 3001.dat".into(),
             name: "x.ldr".into(),
             author: "me\r\n".into(),
             notes: vec!["a\nb".into()],
+            step_notes: Default::default(),
         };
         let text = write(&Assembly::from_order(&[], 24, Color::RED), &meta);
         assert_eq!(

@@ -257,8 +257,9 @@ pub fn settle(
                 .and_then(|p| p.color.spec())
                 .map_or("a colour of their own", |c| c.name);
             repairs.push(format!(
-                "supports: {} columns ({}; {} pieces, {}) under what the model cannot hold itself{}",
+                "supports: {} column{} ({}; {} pieces, {}) under what the model cannot hold itself{}",
                 shored.columns.len(),
+                if shored.columns.len() == 1 { "" } else { "s" },
                 sizes(&shored.columns),
                 shored.pieces.len(),
                 color.to_lowercase(),
