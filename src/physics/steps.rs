@@ -157,9 +157,12 @@ pub(super) fn solve_all(
 /// compression (each point under its centre of mass on a face of the piece
 /// below, down to the ground) still stands with the same
 /// clutch usage, the new pieces using none. Only the other groups are
-/// solved, in parallel. The finished build is solved afresh, so
-/// [`StepsAnalysis::last`] is what [`analyze`](super::analyze) gives (and
-/// the last step's check agrees with it).
+/// solved, in parallel (up to 16 steps ahead at once, so a check that
+/// stops at a failure may have solved a few steps past it). The finished
+/// build is solved afresh, so [`StepsAnalysis::last`] is what
+/// [`analyze`](super::analyze) gives (and the last step's check agrees
+/// with it); with `stop_at_first_failure` and a failure, `last` is the
+/// failing step's structure instead.
 pub fn analyze_steps(
     assembly: &Assembly,
     params: &Params,
@@ -247,9 +250,6 @@ pub fn analyze_steps_from(
             }
         }
         begin = end;
-    }
-    if stop_at_first_failure {
-        ahead.clear();
     }
     let mut solved: std::collections::HashMap<(usize, usize), Vec<PieceStress>> =
         std::collections::HashMap::new();

@@ -8,9 +8,9 @@
 //!   them ([`crate::physics::repair::reorder`]);
 //! - **supports**: where the model still fails, support columns (2 x 2
 //!   where there is room, else narrower) in a colour of their own go under
-//!   what it cannot hold itself, the finished model first, then each step
-//!   that fails ([`crate::physics::support::shore_up`]); `--no-supports`
-//!   leaves them out;
+//!   what it cannot hold itself, one failing step at a time in build
+//!   order ([`crate::physics::support::shore_up`]); `--no-supports` leaves
+//!   them out;
 //! - **layout**: when it still fails, the search runs again with other
 //!   seeds (another layout of the same voxels) and the layout that stands
 //!   longest is kept.
@@ -415,10 +415,12 @@ struct Shoring {
     pieces: Vec<Placement>,
 }
 
-/// Adds support columns to `best` where it still fails: under the
-/// finished model first when it fails, then under each step that does,
-/// checking again after each round and keeping only what makes the build
-/// stand longer.
+/// Adds support columns to `best` where it still fails, one failing step
+/// at a time in build order (the finished model being the last step):
+/// columns under the step's structure, then a check from the first step
+/// they change on to the next failure only, which the next round props.
+/// A round is kept only if more of the model's own pieces stand; at the
+/// end, the steps not yet checked are, so that the report has them all.
 fn support(
     best: &mut Attempt,
     params: &Params,
@@ -427,19 +429,18 @@ fn support(
 ) -> Result<Shoring, crate::pipeline::BuildError> {
     let mut kept = Shoring::default();
     let color = support_color(&best.plan.1);
+    // Whether `best.check` stops at its first failure (no later rows, and
+    // `last` is the failing structure, not the finished model).
+    let mut partial = false;
     while Instant::now() < deadline && kept.columns.len() < MAX_COLUMNS {
-        let target = if !best.check.last.stands() {
-            None
-        } else if let Some(step) = best.check.first_failure {
-            Some(step)
-        } else {
+        let Some(target) = best.check.first_failure else {
             break;
         };
         let asm = &best.plan.1;
         let Some(shored) = shore_up(
             asm,
             params,
-            target,
+            Some(target),
             kept.columns.len(),
             color,
             Some(deadline),
@@ -466,28 +467,12 @@ fn support(
             break;
         }
         // Steps before the first column stand as they did.
-        let from = shored
-            .assembly
-            .pieces
-            .iter()
-            .zip(&asm.pieces)
-            .find(|(a, b)| a != b)
-            .map_or(1, |(a, _)| a.step.0);
-        let c = analyze_steps_from(&shored.assembly, params, false, Some(deadline), from)?;
+        let from = first_change(asm, &shored.assembly);
+        let c = analyze_steps_from(&shored.assembly, params, true, Some(deadline), from)?;
         counts.add(&c);
-        let mut steps: Vec<_> = best
-            .check
-            .steps
-            .iter()
-            .filter(|s| s.step < from)
-            .cloned()
-            .collect();
-        let first_failure = steps
-            .iter()
-            .find(|s| !s.stands)
-            .map(|s| s.step)
-            .or(c.first_failure);
-        steps.extend(c.steps);
+        if !c.complete {
+            break;
+        }
         let supports: Vec<Placement> = best
             .supports
             .iter()
@@ -498,29 +483,56 @@ fn support(
             .order_fix
             .as_ref()
             .map(|m| renumbered(m, asm, &shored.assembly, &supports));
+        let stops = c.first_failure.is_some();
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
-            check: StepsAnalysis {
-                steps,
-                first_failure,
-                ..c
-            },
+            check: spliced(&best.check, from, c),
             order_fix,
             order_tried: best.order_tried,
             supports,
         };
-        if !candidate.check.complete || !candidate.better_than(best) {
+        if candidate.progress() <= best.progress() {
             break;
         }
         *best = candidate;
+        partial = stops;
         kept.columns.extend(shored.columns);
         kept.pieces.extend(shored.pieces);
-        if !shored.stands {
-            break;
+    }
+    if partial {
+        // What still fails: check the rest, the finished model included.
+        if let Some(from) = best.check.first_failure {
+            let c = analyze_steps_from(&best.plan.1, params, false, Some(deadline), from)?;
+            counts.add(&c);
+            best.check = spliced(&best.check, from, c);
         }
     }
     steps_of(&best.plan.1, &mut kept.columns);
     Ok(kept)
+}
+
+/// The first step of `after` that differs from `before` (1 when none
+/// does).
+fn first_change(before: &Assembly, after: &Assembly) -> u32 {
+    after
+        .pieces
+        .iter()
+        .zip(&before.pieces)
+        .find(|(a, b)| a != b)
+        .map_or(1, |(a, _)| a.step.0)
+}
+
+/// The check `c` from step `from` on, after the rows of `old` before it
+/// (which all stand: `from` is at or before `old`'s first failure).
+fn spliced(old: &StepsAnalysis, from: u32, c: StepsAnalysis) -> StepsAnalysis {
+    let mut steps: Vec<_> = old
+        .steps
+        .iter()
+        .filter(|s| s.step < from)
+        .cloned()
+        .collect();
+    steps.extend(c.steps);
+    StepsAnalysis { steps, ..c }
 }
 
 /// `moved` with its target steps as numbered in `after`, which is `before`
