@@ -70,9 +70,14 @@ fn s(p: &Path) -> &str {
 fn build_gallows(tmp: &Path, extra: &[&str]) -> (std::process::Output, PathBuf) {
     let mesh = write_gallows(tmp);
     let out = tmp.join("out");
-    let mut args = vec!["build", s(&mesh), "--studs", "7", "-o", s(&out)];
+    (build(&mesh, "7", &out, extra), out)
+}
+
+/// `brickwright build MESH --studs STUDS -o OUT EXTRA...`.
+fn build(mesh: &Path, studs: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["build", s(mesh), "--studs", studs, "-o", s(out)];
     args.extend_from_slice(extra);
-    (brickwright(&args), out)
+    brickwright(&args)
 }
 
 fn report(out: &Path) -> Value {
@@ -216,17 +221,7 @@ fn a_model_that_stands_says_so_and_stress_needs_the_check() {
     let tmp = tempfile::tempdir().unwrap();
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
     let out = tmp.path().join("out");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
-        "10",
-        "-o",
-        s(&out),
-        "--formats",
-        "ldr,stress",
-        "-q",
-    ]);
+    let run = build(&mesh, "10", &out, &["--formats", "ldr,stress", "-q"]);
     assert!(run.status.success());
     let st = report(&out)["stability"].clone();
     assert_eq!(st["stands"], true, "{st}");
@@ -248,19 +243,12 @@ fn a_model_that_stands_says_so_and_stress_needs_the_check() {
 
     // Off: no section, and naming the stress picture is an error.
     let off = tmp.path().join("off");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
+    let run = build(
+        &mesh,
         "10",
-        "-o",
-        s(&off),
-        "--formats",
-        "ldr",
-        "--stability",
-        "off",
-        "-q",
-    ]);
+        &off,
+        &["--formats", "ldr", "--stability", "off", "-q"],
+    );
     assert!(run.status.success());
     assert!(report(&off)["stability"].is_null());
     let run = brickwright(&[
@@ -282,18 +270,12 @@ fn the_check_stops_at_its_time_budget_and_says_so() {
     let tmp = tempfile::tempdir().unwrap();
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
     let out = tmp.path().join("out");
-    let run = brickwright(&[
-        "build",
-        s(&mesh),
-        "--studs",
+    let run = build(
+        &mesh,
         "10",
-        "-o",
-        s(&out),
-        "--formats",
-        "ldr",
-        "--stability-budget",
-        "0.000001",
-    ]);
+        &out,
+        &["--formats", "ldr", "--stability-budget", "0.000001"],
+    );
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
     assert!(stdout.contains("--stability-budget"), "{stdout}");

@@ -25,6 +25,7 @@ use serde::Serialize;
 
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, Placement};
+use crate::catalog::Color;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
@@ -248,20 +249,16 @@ pub fn settle(
             _ => {}
         }
         if !shored.columns.is_empty() {
-            let color = best
-                .plan
-                .1
-                .pieces
-                .iter()
-                .find(|p| shored.pieces.contains(&p.placement))
-                .and_then(|p| p.color.spec())
+            let color = shored
+                .color
+                .and_then(Color::spec)
                 .map_or("a colour of their own", |c| c.name);
             repairs.push(format!(
                 "supports: {} column{} ({}; {} pieces, {}) under what the model cannot hold itself{}",
                 shored.columns.len(),
                 if shored.columns.len() == 1 { "" } else { "s" },
                 sizes(&shored.columns),
-                shored.pieces.len(),
+                best.supports.len(),
                 color.to_lowercase(),
                 if best.check.first_failure.is_none() {
                     ""
@@ -287,6 +284,7 @@ pub fn settle(
         plan,
         check,
         order_fix,
+        supports,
         ..
     } = best;
     let repaired = mode == Stability::Repair && before.first_failure.is_some();
@@ -297,7 +295,7 @@ pub fn settle(
         &check,
         repairs,
         order_fix.unwrap_or_default(),
-        shored,
+        (shored.columns, supports.len()),
         reseeded,
         repaired.then_some(before),
         on_baseplate,
@@ -408,11 +406,12 @@ fn sizes(columns: &[Column]) -> String {
         .join(", ")
 }
 
-/// The support columns kept.
+/// The support columns kept (their pieces are [`Attempt::supports`]), and
+/// their colour.
 #[derive(Default)]
 struct Shoring {
     columns: Vec<Column>,
-    pieces: Vec<Placement>,
+    color: Option<Color>,
 }
 
 /// Adds support columns to `best` where it still fails, one failing step
@@ -427,8 +426,11 @@ fn support(
     deadline: Instant,
     counts: &mut Counts,
 ) -> Result<Shoring, crate::pipeline::BuildError> {
-    let mut kept = Shoring::default();
     let color = support_color(&best.plan.1);
+    let mut kept = Shoring {
+        columns: Vec::new(),
+        color: Some(color),
+    };
     // Whether `best.check` stops at its first failure (no later rows, and
     // `last` is the failing structure, not the finished model).
     let mut partial = false;
@@ -451,8 +453,8 @@ fn support(
         counts.solves += shored.solves;
         // The model's voxels and the columns' cells: the cover to verify.
         let mut cover = best.plan.0.voxels.clone();
-        let bodies: Vec<_> = kept
-            .pieces
+        let bodies: Vec<_> = best
+            .supports
             .iter()
             .chain(&shored.pieces)
             .map(|p| p.body(asm.layer_ldu))
@@ -497,7 +499,6 @@ fn support(
         *best = candidate;
         partial = stops;
         kept.columns.extend(shored.columns);
-        kept.pieces.extend(shored.pieces);
     }
     if partial {
         // What still fails: check the rest, the finished model included.
@@ -581,7 +582,7 @@ fn report(
     check: &StepsAnalysis,
     repairs: Vec<String>,
     moved: Vec<Moved>,
-    shored: Shoring,
+    (supports, support_pieces): (Vec<Column>, usize),
     reseeded: Option<u64>,
     before: Option<Before>,
     stands_on_baseplate: Option<bool>,
@@ -609,8 +610,8 @@ fn report(
             .collect(),
         repairs,
         moved,
-        support_pieces: shored.pieces.len(),
-        supports: shored.columns,
+        support_pieces,
+        supports,
         reseeded,
         before,
         stands_on_baseplate,
