@@ -229,9 +229,36 @@ struct BuildArgs {
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     time_budget: f64,
-    /// Print nothing but errors.
+    /// Fail (exit 2) when any voxel of the model is left out of the build.
+    #[arg(long)]
+    strict: bool,
+    /// Print nothing but errors and warnings.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// Says on standard error, even with `--quiet`, what the build left out
+/// and where, and when the search ran out of time.
+fn warn_left_out(r: &pipeline::BuildReport) {
+    let rep = &r.repairs;
+    if rep.budget_left_out > 0 {
+        eprintln!(
+            "warning: {}: the search ran out of time (--time-budget {}); {} voxels above the last layer laid are not built (raise --time-budget or lower --studs)",
+            r.input, r.options.time_budget, rep.budget_left_out
+        );
+    }
+    if rep.left_out > 0 {
+        eprintln!(
+            "warning: {}: {} voxels of the model are left out: nothing could join them to the build",
+            r.input, rep.left_out
+        );
+        for p in &rep.left_out_places {
+            eprintln!(
+                "  {} voxels at layer {}, stud ({}, {}): {}",
+                p.voxels, p.layer, p.x, p.y, p.reason
+            );
+        }
+    }
 }
 
 /// Spinners on standard error, one per stage; hidden when not a terminal.
@@ -293,6 +320,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     }
     opts.stability_budget = Duration::from_secs_f64(a.stability_budget);
     opts.supports = !a.no_supports;
+    opts.strict = a.strict;
     opts.stability = match a.stability {
         StabilityArg::Repair => pipeline::Stability::Repair,
         StabilityArg::Check => pipeline::Stability::Check,
@@ -309,6 +337,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     let progress: &dyn Progress = if a.quiet { &Silent } else { &spinners };
     let opts_out = opts.out_dir.clone();
     let out = pipeline::build(&opts, progress)?;
+    warn_left_out(&out.report);
     if !a.quiet {
         let r = &out.report;
         outln!(
@@ -360,18 +389,22 @@ fn run_build(a: BuildArgs) -> Result<()> {
             outln!("  wrote {} step images in {}", steps.len(), dir.display());
         }
         let rep = &r.repairs;
-        if rep.budget_left_out > 0 {
+        if rep.joined_islands + rep.thickened_voxels + rep.evened_voxels + rep.extra_cells > 0 {
             outln!(
-                "  warning: the search ran out of time; the build stops below {} voxels it had no time for (raise --time-budget or lower --studs)",
-                rep.budget_left_out
+                "  repairs: {} islands joined ({} voxels of supports and bridges), {} voxels added to make one-layer sheets two layers thick, {} voxels added to even flat tops to whole courses, {} cells outside the surface filled to join thin features",
+                rep.joined_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.extra_cells
             );
         }
-        if !rep.is_empty() {
-            outln!(
-                "  repairs: {} islands dropped ({} voxels), {} islands propped up ({} voxels added), {} voxels added to make one-layer sheets two layers thick, {} voxels added to even flat tops to whole courses, {} voxels left out that no rule could join",
-                rep.dropped_islands, rep.dropped_voxels, rep.supported_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.dropped_unbuildable
-            );
-        }
+        let q = &r.quality;
+        outln!(
+            "  quality: {} voxels left out, {:.0}% of seams continued, {:.1} voxels a piece, {:.0}% 1x1s, {} studs across (asked {})",
+            q.left_out,
+            100.0 * q.seams_continued,
+            q.voxels_per_piece,
+            100.0 * q.share_1x1,
+            q.extent_studs,
+            q.requested_studs.map_or("by height".to_string(), |n| n.to_string())
+        );
         outln!(
             "  seams: {} of {} vertical seams continue into the course above ({:.0}%; lower is stronger)",
             r.seams.continued,
@@ -383,8 +416,8 @@ fn run_build(a: BuildArgs) -> Result<()> {
         }
         let s = &r.seconds;
         outln!(
-            "  search: {} nodes, {} backtracks, {} parts; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, stability {:.2}s, render {:.2}s, booklet {:.2}s, write {:.2}s",
-            r.search.nodes, r.search.backtracks, r.search.parts, s.load, s.voxelize, s.search, s.verify, s.stability, s.render, s.booklet, s.write
+            "  search: {} nodes, {} candidates, {} joins; time: load {:.2}s, voxelize {:.2}s, search {:.2}s, verify {:.2}s, stability {:.2}s, render {:.2}s, booklet {:.2}s, write {:.2}s",
+            r.search.nodes, r.search.candidates, r.search.joins, s.load, s.voxelize, s.search, s.verify, s.stability, s.render, s.booklet, s.write
         );
     }
     Ok(())

@@ -78,6 +78,8 @@ pub struct BuildOptions {
     /// their own colour under what the model cannot hold itself). Default
     /// true.
     pub supports: bool,
+    /// Fail rather than leave any voxel of the model out. Default off.
+    pub strict: bool,
 }
 
 /// The booklet's note on a step that adds a support column.
@@ -247,6 +249,7 @@ impl BuildOptions {
             stability: Stability::default(),
             stability_budget: DEFAULT_STABILITY_BUDGET,
             supports: true,
+            strict: false,
         }
     }
 }
@@ -301,6 +304,22 @@ pub enum BuildError {
         /// The input file.
         file: String,
         /// Which step fails, and the weak pieces.
+        reason: String,
+    },
+    /// `--strict`, and voxels of the model were left out.
+    #[error("{file}: {voxels} voxels of the model cannot be joined to the build (first at layer {layer}, stud ({x}, {y}): {reason}); --strict refuses to leave them out")]
+    LeftOut {
+        /// The input file.
+        file: String,
+        /// Voxels left out.
+        voxels: usize,
+        /// Layer of the first place.
+        layer: i32,
+        /// Stud column of the first place.
+        x: i32,
+        /// Stud row of the first place.
+        y: i32,
+        /// Why.
         reason: String,
     },
     /// Options that do not go together.
@@ -365,6 +384,9 @@ pub struct BuildReport {
     pub voxels_per_piece: f64,
     /// Vertical seams and how many continue into the course above.
     pub seams: crate::assembly::metrics::SeamStats,
+    /// How good a build it is, in one place: what was left out, seams,
+    /// piece size, 1x1s, size against the size asked for.
+    pub quality: Quality,
     /// Pieces by part and colour, with their BrickLink and Rebrickable ids.
     pub parts: Vec<PartsRow>,
     /// LDraw colours of the build that have no known BrickLink or
@@ -393,6 +415,71 @@ pub struct BuildReport {
     pub repairs: Repairs,
     /// Files written.
     pub outputs: Vec<String>,
+}
+
+/// The quality of a build, as `report.json` gives it and `build` prints it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Quality {
+    /// Voxels of the model not built (nothing could join them, or the
+    /// search ran out of time).
+    pub left_out: usize,
+    /// Where they are, and why.
+    pub left_out_places: Vec<crate::search::LeftOut>,
+    /// Cells outside the model filled to join thin features and islands.
+    pub extra_cells: usize,
+    /// Share of the vertical seams that continue into the course above.
+    pub seams_continued: f64,
+    /// Mean voxels a piece.
+    pub voxels_per_piece: f64,
+    /// Share of the pieces that are 1x1 (bricks or plates).
+    pub share_1x1: f64,
+    /// The build's longest horizontal side, in studs.
+    pub extent_studs: i32,
+    /// The longest side asked for (`--studs`), if sized that way.
+    pub requested_studs: Option<u32>,
+}
+
+impl Quality {
+    fn of(
+        asm: &Assembly,
+        rep: &Repairs,
+        seams: crate::assembly::metrics::SeamStats,
+        sizing: Sizing,
+        input_voxels: usize,
+    ) -> Quality {
+        let n = asm.pieces.len().max(1);
+        let singles = asm
+            .pieces
+            .iter()
+            .filter(|p| p.placement.part.spec().studs() == 1)
+            .count();
+        let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
+        let mut cells = 0usize;
+        for p in &asm.pieces {
+            let b = p.placement.body(asm.layer_ldu);
+            cells += b.volume() as usize;
+            lo = (lo.0.min(b.bbox.min.x), lo.1.min(b.bbox.min.y));
+            hi = (
+                hi.0.max(b.bbox.min.x + b.bbox.sx),
+                hi.1.max(b.bbox.min.y + b.bbox.sy),
+            );
+        }
+        let round = |x: f64, k: f64| (x * k).round() / k;
+        let _ = input_voxels;
+        Quality {
+            left_out: rep.left_out + rep.budget_left_out,
+            left_out_places: rep.left_out_places.clone(),
+            extra_cells: rep.extra_cells,
+            seams_continued: seams.fraction,
+            voxels_per_piece: round(cells as f64 / n as f64, 100.0),
+            share_1x1: round(singles as f64 / n as f64, 10_000.0),
+            extent_studs: (hi.0 - lo.0).max(hi.1 - lo.1).max(0),
+            requested_studs: match sizing {
+                Sizing::Studs(k) => Some(k),
+                Sizing::Height(_) => None,
+            },
+        }
+    }
 }
 
 /// The options part of the report.
@@ -514,7 +601,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let verify_secs = std::cell::Cell::new(0.0);
     let plan = |seed: u64| -> Result<stability::Plan, BuildError> {
         let search_opts = opts.search.clone().with_seed(seed);
-        let outcome = search::build_guided(&model.grid, Some(&model.slant), &rules, &search_opts)
+        let guide = search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+        };
+        let outcome = search::build_guided(&model.grid, guide, &rules, &search_opts)
             .map_err(|reason| BuildError::Search {
             file: file.clone(),
             reason,
@@ -544,6 +635,19 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         Ok((outcome, assembly, order_name))
     };
     let first = plan(opts.search.seed)?;
+    if opts.strict {
+        let rep = &first.0.repairs;
+        if let Some(p) = rep.left_out_places.first() {
+            return Err(BuildError::LeftOut {
+                file,
+                voxels: rep.left_out + rep.budget_left_out,
+                layer: p.layer,
+                x: p.x,
+                y: p.y,
+                reason: p.reason.clone(),
+            });
+        }
+    }
     times.verify = verify_secs.get();
     times.search = secs(t) - times.verify;
     progress.done();
@@ -661,6 +765,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     };
     let parts = PartsList::of(&assembly);
     let pieces = assembly.pieces.len();
+    let seams = crate::assembly::metrics::seams(&assembly);
     let voxels = outcome.voxels.count();
     let mut report = BuildReport {
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -707,7 +812,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                     .min(pieces);
             ((voxels as f64 / own.max(1) as f64) * 100.0).round() / 100.0
         },
-        seams: crate::assembly::metrics::seams(&assembly),
+        seams,
+        quality: Quality::of(&assembly, &outcome.repairs, seams, opts.sizing, model.grid.count()),
         parts: parts.rows(),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: 1,

@@ -174,6 +174,9 @@ pub struct VoxelModel {
     /// Where the surface slants, and which way it faces: what a slope
     /// needs to be placed there.
     pub slant: Slant,
+    /// The cells the surface passes through (filled or not): the layout may
+    /// fill those outside the model to join a feature one voxel thin.
+    pub surface: VoxelGrid,
 }
 
 /// The cells the mesh's surface passes through where it slants, by the way
@@ -393,13 +396,39 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
 
     let grid = fill(&scaled, dims);
     let slant = Slant::mark(&scaled, &tris, grid.dims());
+    let surface = surface_cells(&scaled, grid.dims());
     Ok(VoxelModel {
         grid,
+        surface,
         stud_size: stud as f32,
         layer_height_studs: ratio as f32,
         origin: origin.as_vec3(),
         slant,
     })
+}
+
+/// The cells the triangles (in cell units) pass through, sampled every
+/// third of a cell or finer.
+fn surface_cells(tris: &[[DVec3; 3]], dims: (i32, i32, i32)) -> VoxelGrid {
+    let mut out = VoxelGrid::new(dims.0, dims.1, dims.2);
+    for t in tris {
+        let span = (t[1] - t[0])
+            .length()
+            .max((t[2] - t[0]).length())
+            .max((t[2] - t[1]).length());
+        let steps = (span * 3.0).ceil().clamp(1.0, 4096.0) as usize;
+        for i in 0..=steps {
+            for j in 0..=(steps - i) {
+                let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+                let c = Cell::new(p.x.floor() as i32, p.y.floor() as i32, p.z.floor() as i32);
+                if out.in_bounds(c) {
+                    out.set(c, true);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Fills a grid of `dims` cells from triangles already scaled to cell units

@@ -1,0 +1,375 @@
+//! Local repair: joining the bodies a layout left apart.
+//!
+//! Laying course by course, a piece that rests on nothing (the first piece
+//! of an overhang, a handle's lowest step) starts a body of its own, and the
+//! courses above usually join it to the rest. Where they do not, instead of
+//! backtracking, [`Layout::join`] repairs locally: a piece of the loose body
+//! grows into a bigger piece that reaches a piece of another body above or
+//! below it (filling empty cells beside it), or a new piece is laid on top
+//! of it or under it, across to another body. Each repair takes the fewest
+//! cells outside the model. A body nothing can join is left out, and the
+//! report says where.
+
+use super::layout::{Layout, PieceShape};
+use crate::assembly::Placement;
+use crate::catalog::Shape;
+use crate::geom::{Body, Cell};
+
+/// Rounds of repairs before what is still apart is left out.
+const ROUNDS: usize = 8;
+
+/// A repair: the piece to take out (for a grown one), and the piece to lay.
+struct Fix {
+    replaces: Option<u32>,
+    placement: Placement,
+    body: Body,
+    extra: usize,
+}
+
+impl Layout<'_> {
+    /// The bodies of laid pieces: the pieces of each, largest body (by
+    /// cells) first.
+    pub fn bodies(&mut self) -> Vec<Vec<u32>> {
+        let mut by_root: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+        for i in 0..self.pieces.len() as u32 {
+            if !self.pieces[i as usize].gone {
+                let r = self.uf.find(i);
+                by_root.entry(r).or_default().push(i);
+            }
+        }
+        let mut bodies: Vec<Vec<u32>> = by_root.into_values().collect();
+        let volume = |b: &Vec<u32>, l: &Layout| -> i32 {
+            b.iter().map(|&i| l.pieces[i as usize].body.volume()).sum()
+        };
+        let mut keyed: Vec<(i32, Vec<u32>)> =
+            bodies.drain(..).map(|b| (volume(&b, self), b)).collect();
+        keyed.sort_by(|a, b| b.0.cmp(&a.0).then(a.1[0].cmp(&b.1[0])));
+        keyed.into_iter().map(|(_, b)| b).collect()
+    }
+
+    /// Joins every body to another until the pieces are one body; leaves
+    /// out the bodies nothing joins.
+    pub fn join(&mut self, rng: &mut impl rand::Rng) {
+        self.rebuild_bodies();
+        for _ in 0..ROUNDS {
+            let bodies = self.bodies();
+            if bodies.len() <= 1 {
+                return;
+            }
+            let mut progress = false;
+            // Smallest loose body first: it has the fewest ways out.
+            for body in bodies[1..].iter().rev() {
+                let root = self.uf.find(body[0]);
+                if self.uf.find(bodies[0][0]) == root {
+                    continue;
+                }
+                if let Some(fix) = self.find_fix(body, root) {
+                    if let Some(old) = fix.replaces {
+                        self.remove(old);
+                    }
+                    self.repairs.extra_cells += fix.extra;
+                    self.place(fix.placement, fix.body, None);
+                    self.stats.joins += 1;
+                    progress = true;
+                } else if self.retile_across(body, root, rng) {
+                    self.stats.joins += 1;
+                    progress = true;
+                }
+            }
+            self.rebuild_bodies();
+            if !progress {
+                break;
+            }
+        }
+        let bodies = self.bodies();
+        for body in bodies.iter().skip(1) {
+            let mut cells = 0;
+            let mut first: Option<Cell> = None;
+            for &i in body {
+                let b = self.pieces[i as usize].body;
+                cells += b.cells().filter(|&q| self.must.get(q)).count();
+                first = Some(first.map_or(b.bbox.min, |f| f.min(b.bbox.min)));
+                self.remove(i);
+            }
+            if let Some(at) = first {
+                self.repairs
+                    .leave_out(at, cells, "no piece can join it to the rest of the build");
+            }
+        }
+        self.rebuild_bodies();
+    }
+
+    /// The repair that joins the body `body` (root `root`) to another with
+    /// the fewest cells outside the model.
+    fn find_fix(&mut self, body: &[u32], root: u32) -> Option<Fix> {
+        let mut best: Option<Fix> = None;
+        let roots: Vec<u32> = (0..self.pieces.len() as u32)
+            .map(|i| self.uf.find(i))
+            .collect();
+        let rects: Vec<PieceShape> = self
+            .shapes
+            .iter()
+            .filter(|s| s.part.spec().shape == Shape::Rect)
+            .cloned()
+            .collect();
+        for &i in body {
+            let p = self.pieces[i as usize];
+            // Grow the piece itself.
+            if p.placement.part.spec().shape == Shape::Rect {
+                for s in &rects {
+                    let h = s.body_at(Cell::new(0, 0, 0)).bbox.sz;
+                    if h != p.body.bbox.sz {
+                        continue;
+                    }
+                    let (fx, fy) = s.part.spec().footprint(s.rot);
+                    let b = p.body.bbox;
+                    for ox in b.min.x + b.sx - fx..=b.min.x {
+                        for oy in b.min.y + b.sy - fy..=b.min.y {
+                            let origin = Cell::new(ox, oy, b.min.z);
+                            self.consider(s, origin, Some(i), (root, &roots), &mut best);
+                        }
+                    }
+                }
+            }
+            // A piece on top of it, or under it.
+            for s in &rects {
+                let nb = s.body_at(Cell::new(0, 0, 0));
+                let h = nb.bbox.sz;
+                let (fx, fy) = s.part.spec().footprint(s.rot);
+                let b = p.body;
+                for t in b.studs.cells() {
+                    for ox in t.x - fx + 1..=t.x {
+                        for oy in t.y - fy + 1..=t.y {
+                            self.consider(s, Cell::new(ox, oy, t.z + 1), None, (root, &roots), &mut best);
+                        }
+                    }
+                }
+                for t in b.tubes.cells() {
+                    for ox in t.x - fx + 1..=t.x {
+                        for oy in t.y - fy + 1..=t.y {
+                            self.consider(s, Cell::new(ox, oy, t.z - h), None, (root, &roots), &mut best);
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Lays again a piece of the body `body` (root `root`) and a piece of
+    /// another body beside it in the same layers, with a piece across the
+    /// two first, the rest of their voxels as the layout would: for a body
+    /// that meets the rest side by side (a handle against a wall). Kept
+    /// only if it joins the body to another; undone otherwise.
+    fn retile_across(&mut self, body: &[u32], root: u32, rng: &mut impl rand::Rng) -> bool {
+        let roots: Vec<u32> = (0..self.pieces.len() as u32)
+            .map(|i| self.uf.find(i))
+            .collect();
+        let mut tries = 0;
+        for &h in body {
+            let hb = self.pieces[h as usize].body;
+            if self.pieces[h as usize].placement.part.spec().shape != Shape::Rect {
+                continue;
+            }
+            let mut others: Vec<u32> = Vec::new();
+            for q in hb.cells() {
+                for n in [
+                    q.offset(1, 0, 0),
+                    q.offset(-1, 0, 0),
+                    q.offset(0, 1, 0),
+                    q.offset(0, -1, 0),
+                ] {
+                    if let Some(w) = self.owner_of(n) {
+                        let wb = self.pieces[w as usize].body;
+                        if roots[w as usize] != root
+                            && !others.contains(&w)
+                            && wb.bbox.min.z == hb.bbox.min.z
+                            && wb.bbox.sz == hb.bbox.sz
+                            && wb.is_box()
+                        {
+                            others.push(w);
+                        }
+                    }
+                }
+            }
+            for w in others {
+                tries += 1;
+                if tries > 64 {
+                    return false;
+                }
+                if self.retile_pair((h, w), (root, &roots), rng) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// [`Layout::retile_across`] for pieces `h` (of the body `root`, whose
+    /// pieces' roots before the repair are `roots`) and `w`.
+    fn retile_pair(
+        &mut self,
+        (h, w): (u32, u32),
+        (root, roots): (u32, &[u32]),
+        rng: &mut impl rand::Rng,
+    ) -> bool {
+        let (hp, wp) = (self.pieces[h as usize], self.pieces[w as usize]);
+        let cells: Vec<Cell> = hp
+            .body
+            .cells()
+            .chain(wp.body.cells())
+            .filter(|&q| self.must.get(q))
+            .collect();
+        let first_new = self.pieces.len() as u32;
+        let extra_before = self.repairs.extra_cells;
+        self.remove(h);
+        self.remove(w);
+        let ok = match self.across(&hp.body, &wp.body) {
+            Some((p, b)) => {
+                self.place(p, b, None);
+                for &c in &cells {
+                    if self.owner_of(c).is_none() {
+                        if let Some(cand) = self.choose(c, rng) {
+                            self.repairs.extra_cells += cand.extra;
+                            self.place(cand.placement, cand.body, None);
+                        }
+                    }
+                }
+                let covered = cells.iter().all(|&c| self.owner_of(c).is_some());
+                self.rebuild_bodies();
+                let r = self.uf.find(first_new);
+                let alone = roots.iter().filter(|&&x| x == root).count() == 1;
+                let (mut mine, mut other) = (alone, false);
+                for i in 0..first_new {
+                    if self.pieces[i as usize].gone || self.uf.find(i) != r {
+                        continue;
+                    }
+                    if roots[i as usize] == root {
+                        mine = true;
+                    } else {
+                        other = true;
+                    }
+                }
+                covered && mine && other
+            }
+            None => false,
+        };
+        if !ok {
+            for i in first_new..self.pieces.len() as u32 {
+                if !self.pieces[i as usize].gone {
+                    self.remove(i);
+                }
+            }
+            self.repairs.extra_cells = extra_before;
+            self.restore(h);
+            self.restore(w);
+            self.rebuild_bodies();
+        }
+        ok
+    }
+
+    /// The biggest brick over the model's free voxels in the layers of `a`
+    /// that reaches into the boxes of both `a` and `b`.
+    fn across(&self, a: &Body, b: &Body) -> Option<(Placement, Body)> {
+        let mut best: Option<(i32, Placement, Body)> = None;
+        for shape in self.shapes.iter() {
+            if shape.part.spec().shape != Shape::Rect {
+                continue;
+            }
+            let (fx, fy) = shape.part.spec().footprint(shape.rot);
+            let ab = a.bbox;
+            for ox in ab.min.x - fx + 1..ab.min.x + ab.sx {
+                for oy in ab.min.y - fy + 1..ab.min.y + ab.sy {
+                    let origin = Cell::new(ox, oy, ab.min.z);
+                    let body = shape.body_at(origin);
+                    if body.bbox.sz != ab.sz
+                        || !body.bbox.intersects(&ab)
+                        || !body.bbox.intersects(&b.bbox)
+                        || !body
+                            .cells()
+                            .all(|q| self.must.get(q) && self.owner_of(q).is_none())
+                    {
+                        continue;
+                    }
+                    let v = body.volume();
+                    if best.as_ref().is_none_or(|x| v > x.0) {
+                        best = Some((v, Placement::new(shape.part, origin, shape.rot), body));
+                    }
+                }
+            }
+        }
+        best.map(|(_, p, b)| (p, b))
+    }
+
+    /// Keeps shape `s` at `origin` in `best` if it joins the body `root`
+    /// to another (taking the place of piece `replaces`) with fewer cells
+    /// outside the model.
+    fn consider(
+        &self,
+        s: &PieceShape,
+        origin: Cell,
+        replaces: Option<u32>,
+        (root, roots): (u32, &[u32]),
+        best: &mut Option<Fix>,
+    ) {
+        let body = s.body_at(origin);
+        let mut extra = 0;
+        for q in body.cells() {
+            if !self.must.in_bounds(q) {
+                return;
+            }
+            match self.owner_of(q) {
+                None => {}
+                Some(o) if Some(o) == replaces => continue,
+                Some(_) => return,
+            }
+            if self.must.get(q) {
+                continue;
+            }
+            extra += 1;
+            if best.as_ref().is_some_and(|b| extra >= b.extra) {
+                return;
+            }
+        }
+        if replaces.is_some() && extra == 0 {
+            return; // the same piece
+        }
+        let placement = Placement::new(s.part, origin, s.rot);
+        let mut joins_mine = false;
+        let mut joins_other = false;
+        let below = self.below(&body);
+        let above = self.above(&body);
+        let ok = |o: u32, lower: bool| {
+            let a = &self.pieces[o as usize].placement;
+            let u = self.layer_ldu;
+            if lower {
+                self.book.joint(a, &placement, crate::grammar::Dir::Up, u).is_some()
+                    || self.book.joint(&placement, a, crate::grammar::Dir::Down, u).is_some()
+            } else {
+                self.book.joint(a, &placement, crate::grammar::Dir::Down, u).is_some()
+                    || self.book.joint(&placement, a, crate::grammar::Dir::Up, u).is_some()
+            }
+        };
+        for (list, lower) in [(&below, true), (&above, false)] {
+            for &o in list.iter() {
+                if Some(o) == replaces || !ok(o, lower) {
+                    continue;
+                }
+                if roots[o as usize] == root {
+                    joins_mine = true;
+                } else {
+                    joins_other = true;
+                }
+            }
+        }
+        // A grown piece keeps its own body through itself.
+        if (joins_mine || replaces.is_some()) && joins_other {
+            *best = Some(Fix {
+                replaces,
+                placement,
+                body,
+                extra,
+            });
+        }
+    }
+}

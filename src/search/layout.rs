@@ -1,0 +1,757 @@
+//! The course-by-course layout: a forward derivation in which every piece
+//! is chosen among scored candidates.
+//!
+//! Layer by layer from the bottom, the layout takes the first voxel not yet
+//! covered (scanning rows in one course, columns in the next) and lays the
+//! best piece over it. A candidate is any piece of the alphabet, in any
+//! turn, placed so that it covers that voxel, fills only free cells of the
+//! model (or cells the surface passes through, and, to join a feature one
+//! voxel thin, empty cells beside it) and keeps a slope's open face clear.
+//! Its score weighs, per [`Weights`]:
+//!
+//! - **size**: voxels covered (a bigger piece, fewer pieces);
+//! - **fidelity**: cells filled outside the model cost;
+//! - **stagger**: each side of the piece that lies on a seam of the course
+//!   below continues it and costs; each seam below the piece bridges costs
+//!   nothing and earns;
+//! - **interlock**: resting on several pieces below earns, joining pieces
+//!   that were not yet one body earns more; resting on nothing costs;
+//! - **the rules' weights**: the piece joins a piece below through a rule
+//!   of the loaded file (a candidate that joins the pieces below through no
+//!   rule is not a candidate), and `ln(weight / mean weight)` of the
+//!   heaviest such rule is added;
+//! - **courses**: a long piece laid along the course's direction earns
+//!   (directions alternate course to course, so walls and solids bond);
+//! - **no small leftovers**: a free voxel the piece would leave with no free
+//!   neighbour (only a 1x1 could cover it) costs, and so does a 1x1.
+//!
+//! Seeded Gumbel noise on each score makes the choice a draw from the
+//! softmax of the scores: the seed varies the layout among near-equal
+//! candidates and no further.
+//!
+//! Complex rules are tested first, once every
+//! [`SearchOptions::complex_every`] nodes, as in the paper: one picked with
+//! equal probability, placed so that a new piece covers the voxel, applies
+//! when its `u` pieces are in place and its new pieces fit.
+
+use std::time::Instant;
+
+use rand::Rng;
+
+use super::prepare::{neighbors6, Repairs};
+use super::rulebook::RuleBook;
+use super::{Dice, SearchOptions, SearchStats};
+use crate::assembly::Placement;
+use crate::catalog::{PartKind, Shape};
+use crate::geom::{Body, Cell, Rot};
+use crate::grammar::{Dir, RuleSet};
+use crate::voxel::{Slant, VoxelGrid};
+
+/// No piece owns the cell.
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// The weights of a candidate's score (see the module docs).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Weights {
+    /// Per voxel of the model covered.
+    pub size: f64,
+    /// Per cell the surface passes through, outside the model.
+    pub near: f64,
+    /// Per other empty cell filled.
+    pub far: f64,
+    /// Per side face continuing a seam of the course below.
+    pub seam: f64,
+    /// Per seam face of the course below the piece bridges.
+    pub bridge_seam: f64,
+    /// Per extra piece below the piece rests on (up to three).
+    pub bridge: f64,
+    /// Per extra body the piece joins into one.
+    pub merge: f64,
+    /// Resting on nothing above the ground.
+    pub loose: f64,
+    /// Times `ln(weight / mean weight)` of the rule.
+    pub rule: f64,
+    /// A long piece along the course's direction.
+    pub along: f64,
+    /// Per free voxel left with no free neighbour.
+    pub isolated: f64,
+    /// A 1x1.
+    pub single: f64,
+    /// Temperature of the Gumbel noise.
+    pub noise: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Weights {
+            size: 1.0,
+            near: 2.0,
+            far: 3.0,
+            seam: 0.9,
+            bridge_seam: 0.3,
+            bridge: 0.6,
+            merge: 3.0,
+            loose: 4.0,
+            rule: 0.25,
+            along: 0.4,
+            isolated: 1.5,
+            single: 1.0,
+            noise: 0.05,
+        }
+    }
+}
+
+/// A piece of the alphabet in one turn, its body at the origin.
+#[derive(Debug, Clone)]
+pub(crate) struct PieceShape {
+    pub part: PartKind,
+    pub rot: Rot,
+    body: Body,
+    /// Filled cells of the bottom layer, relative to the origin.
+    bottom: Vec<Cell>,
+    /// Long side along x (`Some(true)`), along y, or square.
+    long_x: Option<bool>,
+    single: bool,
+}
+
+impl PieceShape {
+    /// The body with its minimum corner at `origin`.
+    pub fn body_at(&self, origin: Cell) -> Body {
+        self.body.moved(origin.x, origin.y, origin.z)
+    }
+}
+
+/// Every distinct turn of every part of `rules`' alphabet.
+pub(crate) fn shapes(rules: &RuleSet) -> Vec<PieceShape> {
+    let u = rules.layer_ldu();
+    let mut out: Vec<PieceShape> = Vec::new();
+    for &part in rules.alphabet() {
+        for rot in Rot::ALL {
+            let rot = part.spec().canonical_rot(rot);
+            if out.iter().any(|s| s.part == part && s.rot == rot) {
+                continue;
+            }
+            let body = part.body(rot, Cell::new(0, 0, 0), u);
+            let bottom = body.cells().filter(|c| c.z == 0).collect();
+            let (fx, fy) = part.spec().footprint(rot);
+            out.push(PieceShape {
+                part,
+                rot,
+                body,
+                bottom,
+                long_x: (fx != fy).then_some(fx > fy),
+                single: fx * fy == 1,
+            });
+        }
+    }
+    // Biggest first: among equal scores the bigger piece wins.
+    out.sort_by_key(|s| (std::cmp::Reverse(s.body.volume()), s.part, s.rot));
+    out
+}
+
+/// A piece laid.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Laid {
+    pub placement: Placement,
+    pub body: Body,
+    /// The complex rule application that laid it, if one did: an index
+    /// into [`Layout::groups`].
+    pub group: Option<u32>,
+    /// Taken out again (replaced by a bigger piece, or left out).
+    pub gone: bool,
+}
+
+/// One complex rule application: its variant, the laid pieces its `u`
+/// matched and the pieces it added, in its order.
+#[derive(Debug, Clone)]
+pub(crate) struct Group {
+    pub variant: u32,
+    pub u: Vec<u32>,
+    pub v: Vec<u32>,
+}
+
+/// Union-find over laid pieces: which pieces are one body so far.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct UnionFind {
+    parent: Vec<u32>,
+}
+
+impl UnionFind {
+    pub fn add(&mut self) {
+        self.parent.push(self.parent.len() as u32);
+    }
+
+    pub fn find(&mut self, mut a: u32) -> u32 {
+        while self.parent[a as usize] != a {
+            let p = self.parent[a as usize];
+            self.parent[a as usize] = self.parent[p as usize];
+            a = p;
+        }
+        a
+    }
+
+    pub fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.parent[hi as usize] = lo;
+        }
+    }
+}
+
+/// Which cells a candidate may fill beyond the model's voxels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Reach {
+    /// Cells the surface passes through.
+    Near,
+    /// Any empty cell.
+    Far,
+}
+
+/// The layout in progress.
+pub(crate) struct Layout<'a> {
+    pub rules: &'a RuleSet,
+    pub book: RuleBook,
+    pub layer_ldu: i32,
+    /// Layers in a brick course.
+    pub course: i32,
+    /// The voxels to cover.
+    pub must: &'a VoxelGrid,
+    /// Empty cells the surface passes through.
+    pub near: VoxelGrid,
+    pub slant: Option<&'a Slant>,
+    pub shapes: Vec<PieceShape>,
+    pub weights: Weights,
+    /// The piece owning each cell, or [`NONE`].
+    pub owner: Vec<u32>,
+    pub pieces: Vec<Laid>,
+    pub groups: Vec<Group>,
+    pub uf: UnionFind,
+    pub stats: SearchStats,
+    pub repairs: Repairs,
+    dims: (i32, i32, i32),
+}
+
+/// A scored candidate.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Candidate {
+    pub placement: Placement,
+    pub body: Body,
+    pub score: f64,
+    /// Cells it fills outside the model.
+    pub extra: usize,
+    /// Whether it rests on a piece below.
+    pub rests: bool,
+}
+
+impl<'a> Layout<'a> {
+    pub fn new(
+        rules: &'a RuleSet,
+        must: &'a VoxelGrid,
+        surface: Option<&VoxelGrid>,
+        slant: Option<&'a Slant>,
+    ) -> Layout<'a> {
+        let dims = must.dims();
+        let (nx, ny, nz) = dims;
+        // Cells the surface passes through, outside the voxels; without a
+        // surface, every empty cell touching a voxel.
+        let mut near = VoxelGrid::new(nx, ny, nz);
+        match surface {
+            Some(s) => {
+                for c in s.cells() {
+                    if !must.get(c) {
+                        near.set(c, true);
+                    }
+                }
+            }
+            None => {
+                for c in must.cells() {
+                    for dz in -1..=1 {
+                        for dy in -1..=1 {
+                            for dx in -1..=1 {
+                                let n = c.offset(dx, dy, dz);
+                                if must.in_bounds(n) && !must.get(n) {
+                                    near.set(n, true);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let layer_ldu = rules.layer_ldu();
+        Layout {
+            rules,
+            book: RuleBook::new(rules),
+            layer_ldu,
+            course: (24 / layer_ldu).max(1),
+            must,
+            near,
+            slant,
+            shapes: shapes(rules),
+            weights: Weights::default(),
+            owner: vec![NONE; must.len()],
+            pieces: Vec::new(),
+            groups: Vec::new(),
+            uf: UnionFind::default(),
+            stats: SearchStats::default(),
+            repairs: Repairs::default(),
+            dims,
+        }
+    }
+
+    pub fn dims(&self) -> (i32, i32, i32) {
+        self.dims
+    }
+
+    /// The piece owning `c`, if any (out of the grid: none).
+    pub fn owner_of(&self, c: Cell) -> Option<u32> {
+        if !self.must.in_bounds(c) {
+            return None;
+        }
+        let o = self.owner[self.must.index(c)];
+        (o != NONE).then_some(o)
+    }
+
+    fn free(&self, c: Cell) -> bool {
+        self.must.in_bounds(c) && self.owner[self.must.index(c)] == NONE
+    }
+
+    /// Lays every layer, bottom first, until done or `deadline`.
+    pub fn lay(&mut self, opts: &SearchOptions, dice: &mut Dice, deadline: Instant) {
+        let (nx, ny, nz) = self.dims;
+        for z in 0..nz {
+            if Instant::now() >= deadline {
+                let left: Vec<Cell> = (z..nz)
+                    .flat_map(|k| self.must.layer_cells(k).collect::<Vec<_>>())
+                    .filter(|&c| self.free(c))
+                    .collect();
+                self.repairs.budget_left_out = left.len();
+                self.stats.budget_hit = true;
+                return;
+            }
+            let rows = (z / self.course) % 2 == 1;
+            let (outer, inner) = if rows { (nx, ny) } else { (ny, nx) };
+            for a in 0..outer {
+                for b in 0..inner {
+                    let c = if rows {
+                        Cell::new(a, b, z)
+                    } else {
+                        Cell::new(b, a, z)
+                    };
+                    if self.must.get(c) && self.free(c) {
+                        self.cover(c, opts, dice);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Covers the voxel `c` with the best piece, or a complex rule's
+    /// pieces, or leaves it out when no piece fits.
+    fn cover(&mut self, c: Cell, opts: &SearchOptions, dice: &mut Dice) {
+        self.stats.nodes += 1;
+        let k = u64::from(opts.complex_every);
+        if k > 0 && self.stats.nodes % k == 0 && !self.rules.complex_variants().is_empty() {
+            self.stats.complex_tried += 1;
+            let n = self.rules.complex_variants().len();
+            let variant = dice.complex.gen_range(0..n) as u32;
+            if self.try_complex(variant, c) {
+                self.stats.complex_applied += 1;
+                return;
+            }
+        }
+        let best = self.choose(c, &mut dice.rules);
+        match best {
+            Some(b) => {
+                self.repairs.extra_cells += b.extra;
+                self.place(b.placement, b.body, None);
+            }
+            None => {
+                // The scan passes each voxel once: it stays unbuilt.
+                self.repairs
+                    .leave_out(c, 1, "no piece of the rule file fits there");
+            }
+        }
+    }
+
+    /// The piece to lay over `c`: the best one among the model's voxels
+    /// and the cells the surface passes through, or, when that one rests on
+    /// nothing above the ground, the best one reaching across empty cells
+    /// if it scores higher.
+    pub fn choose(&mut self, c: Cell, rng: &mut impl Rng) -> Option<Candidate> {
+        let mut best = self.best(c, Reach::Near, rng);
+        if best.is_none_or(|b| !b.rests && c.z > 0) {
+            if let Some(far) = self.best(c, Reach::Far, rng) {
+                if best.is_none_or(|b| far.score > b.score) {
+                    self.stats.widened += 1;
+                    best = Some(far);
+                }
+            }
+        }
+        best
+    }
+
+    /// The best candidate covering `c`, reaching as far as `reach`.
+    fn best(&mut self, c: Cell, reach: Reach, rng: &mut impl Rng) -> Option<Candidate> {
+        let mut best: Option<Candidate> = None;
+        for s in 0..self.shapes.len() {
+            for k in 0..self.shapes[s].bottom.len() {
+                let key = self.shapes[s].bottom[k];
+                let origin = c.offset(-key.x, -key.y, -key.z);
+                let Some(mut cand) = self.eval(s, origin, reach) else {
+                    continue;
+                };
+                self.stats.candidates += 1;
+                if self.weights.noise > 0.0 {
+                    let u: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
+                    cand.score -= self.weights.noise * (-u.ln()).ln();
+                }
+                if best.is_none_or(|b| cand.score > b.score) {
+                    best = Some(cand);
+                }
+            }
+        }
+        best
+    }
+
+    /// Whether the piece `body` fits: every cell free and allowed by
+    /// `reach`, a slope's open face clear of the model and of pieces and
+    /// slanting the way the mesh does. Returns how many cells it fills of
+    /// the model's voxels, of the cells the surface passes through, and of
+    /// other empty cells.
+    fn fits(&self, placement: &Placement, body: &Body, reach: Reach) -> Option<(usize, usize, usize)> {
+        let (mut inside, mut outside, mut far) = (0, 0, 0);
+        for b in body.boxes() {
+            for q in b.cells() {
+                if !self.free(q) {
+                    return None;
+                }
+                if self.must.get(q) {
+                    inside += 1;
+                } else if self.near.get(q) {
+                    outside += 1;
+                } else {
+                    far += 1;
+                }
+            }
+        }
+        if far > 0 && reach == Reach::Near {
+            return None;
+        }
+        if !body.is_box() && !self.face_fits(placement, body) {
+            return None;
+        }
+        Some((inside, outside, far))
+    }
+
+    /// A slope's open cells (those of its box it does not fill) are clear
+    /// of the model and of pieces, and where the mesh's slant is known, it
+    /// slants there the way the slope faces (in those cells or the slope's
+    /// own cells beside them).
+    fn face_fits(&self, p: &Placement, b: &Body) -> bool {
+        let open = || b.bbox.cells().filter(|&q| !b.contains(q));
+        if !open().all(|q| self.free(q) && !self.must.get(q)) {
+            return false;
+        }
+        let Some(slant) = self.slant else {
+            return true;
+        };
+        let spec = p.part.spec();
+        let (bx, by) = spec.back(p.rot);
+        let up = spec.shape == Shape::Slope;
+        let Some(g) = slant.facing((-bx, -by), up) else {
+            return true;
+        };
+        let inward = if up { -1 } else { 1 };
+        open().any(|q| g.get(q) || g.get(q.offset(0, 0, inward)))
+    }
+
+    /// The pieces `body` rests on (their studs in its tubes), each once.
+    pub fn below(&self, body: &Body) -> Vec<u32> {
+        let mut out: Vec<u32> = Vec::new();
+        if body.tubes.min.z == 0 {
+            return out;
+        }
+        for t in body.tubes.cells() {
+            let q = t.offset(0, 0, -1);
+            if let Some(o) = self.owner_of(q) {
+                if !out.contains(&o) && self.pieces[o as usize].body.studs.contains(q) {
+                    out.push(o);
+                }
+            }
+        }
+        out
+    }
+
+    /// The pieces resting on `body` (its studs in their tubes), each once.
+    pub fn above(&self, body: &Body) -> Vec<u32> {
+        let mut out: Vec<u32> = Vec::new();
+        for t in body.studs.cells() {
+            let q = t.offset(0, 0, 1);
+            if let Some(o) = self.owner_of(q) {
+                if !out.contains(&o) && self.pieces[o as usize].body.tubes.contains(q) {
+                    out.push(o);
+                }
+            }
+        }
+        out
+    }
+
+    /// Scores shape `s` at `origin`, or `None` if it does not fit or joins
+    /// the pieces below through no rule.
+    fn eval(&mut self, s: usize, origin: Cell, reach: Reach) -> Option<Candidate> {
+        let shape = &self.shapes[s];
+        let placement = Placement::new(shape.part, origin, shape.rot);
+        let body = shape.body.moved(origin.x, origin.y, origin.z);
+        let (inside, near, far) = self.fits(&placement, &body, reach)?;
+        let w = self.weights;
+        let below = self.below(&body);
+        let mut rule_w: Option<f64> = None;
+        for &o in &below {
+            let a = &self.pieces[o as usize].placement;
+            let up = self.book.joint(a, &placement, Dir::Up, self.layer_ldu);
+            let down = self.book.joint(&placement, a, Dir::Down, self.layer_ldu);
+            for (wt, _) in up.into_iter().chain(down) {
+                rule_w = Some(rule_w.map_or(wt, |r: f64| r.max(wt)));
+            }
+        }
+        if !below.is_empty() && rule_w.is_none() {
+            return None;
+        }
+        let mut score = w.size * inside as f64 - w.near * near as f64 - w.far * far as f64;
+        if let Some(wt) = rule_w {
+            score += w.rule * (wt / self.book.mean).ln();
+        }
+        let z = origin.z;
+        if below.is_empty() && z > 0 {
+            score -= w.loose;
+        }
+        if below.len() >= 2 {
+            score += w.bridge * (below.len() - 1).min(3) as f64;
+            let mut roots: Vec<u32> = below.iter().map(|&o| self.uf.find(o)).collect();
+            roots.sort_unstable();
+            roots.dedup();
+            score += w.merge * (roots.len() - 1) as f64;
+        }
+        if let Some(long_x) = shape.long_x {
+            let rows = (z / self.course) % 2 == 1;
+            if long_x != rows {
+                score += w.along;
+            }
+        }
+        if shape.single {
+            score -= w.single;
+        }
+        let (seams, bridged, isolated) = self.seam_terms(&body, z);
+        score += w.bridge_seam * bridged as f64 - w.seam * seams as f64
+            - w.isolated * isolated as f64;
+        Some(Candidate {
+            placement,
+            body,
+            score,
+            extra: near + far,
+            rests: !below.is_empty(),
+        })
+    }
+
+    /// For a piece `body` with its bottom in layer `z`: the side faces that
+    /// continue a seam of the layer below, the seams below it bridges, and
+    /// the free voxels beside it it would leave with no free neighbour.
+    fn seam_terms(&self, body: &Body, z: i32) -> (usize, usize, usize) {
+        let (mut seams, mut bridged, mut isolated) = (0, 0, 0);
+        let bottom = body.boxes()[0];
+        let foot = crate::geom::CellBox { sz: 1, ..bottom };
+        let seam_below = |a: Cell, b: Cell| -> bool {
+            if z == 0 {
+                return false;
+            }
+            match (
+                self.owner_of(a.offset(0, 0, -1)),
+                self.owner_of(b.offset(0, 0, -1)),
+            ) {
+                (Some(x), Some(y)) => x != y,
+                _ => false,
+            }
+        };
+        for q in foot.cells() {
+            for n in [
+                q.offset(1, 0, 0),
+                q.offset(-1, 0, 0),
+                q.offset(0, 1, 0),
+                q.offset(0, -1, 0),
+            ] {
+                if foot.contains(n) {
+                    // Count each inner face once.
+                    if (n.x > q.x || n.y > q.y) && seam_below(q, n) {
+                        bridged += 1;
+                    }
+                    continue;
+                }
+                if !self.must.in_bounds(n) {
+                    continue;
+                }
+                let free_voxel = self.must.get(n) && self.free(n);
+                if (free_voxel || !self.free(n)) && seam_below(q, n) {
+                    seams += 1;
+                }
+                if free_voxel
+                    && !neighbors6(n)[..4]
+                        .iter()
+                        .any(|&m| !foot.contains(m) && self.must.get(m) && self.free(m))
+                {
+                    isolated += 1;
+                }
+            }
+        }
+        (seams, bridged, isolated)
+    }
+
+    /// Lays `placement` (its body `body`), joined to the pieces it rests on
+    /// through a rule.
+    pub fn place(&mut self, placement: Placement, body: Body, group: Option<u32>) -> u32 {
+        let id = self.pieces.len() as u32;
+        for q in body.cells() {
+            let i = self.must.index(q);
+            self.owner[i] = id;
+        }
+        self.pieces.push(Laid {
+            placement,
+            body,
+            group,
+            gone: false,
+        });
+        self.uf.add();
+        for o in self.below(&body) {
+            if self.joined_by_rule(o, id) {
+                self.uf.union(o, id);
+            }
+        }
+        for o in self.above(&body) {
+            if self.joined_by_rule(id, o) {
+                self.uf.union(o, id);
+            }
+        }
+        id
+    }
+
+    /// Takes piece `id` out: its cells are free again, and a complex rule
+    /// application it was part of counts as basic rules from now on.
+    pub fn remove(&mut self, id: u32) {
+        let p = &mut self.pieces[id as usize];
+        p.gone = true;
+        let body = p.body;
+        if let Some(g) = p.group {
+            for &k in &self.groups[g as usize].v {
+                self.pieces[k as usize].group = None;
+            }
+            self.groups[g as usize].v.clear();
+        }
+        for q in body.cells() {
+            let i = self.must.index(q);
+            if self.owner[i] == id {
+                self.owner[i] = NONE;
+            }
+        }
+    }
+
+    /// Puts back piece `id`, taken out by [`Layout::remove`]: its cells
+    /// must be free.
+    pub fn restore(&mut self, id: u32) {
+        let p = &mut self.pieces[id as usize];
+        p.gone = false;
+        let body = p.body;
+        for q in body.cells() {
+            let i = self.must.index(q);
+            self.owner[i] = id;
+        }
+    }
+
+    /// Whether the rules join `a` and `b`, pieces in place where one rests
+    /// on the other.
+    pub fn joined_by_rule(&self, lower: u32, upper: u32) -> bool {
+        let (l, u) = (
+            &self.pieces[lower as usize].placement,
+            &self.pieces[upper as usize].placement,
+        );
+        self.book.joint(l, u, Dir::Up, self.layer_ldu).is_some()
+            || self.book.joint(u, l, Dir::Down, self.layer_ldu).is_some()
+    }
+
+    /// Recomputes which pieces are one body, from scratch.
+    pub fn rebuild_bodies(&mut self) {
+        self.uf = UnionFind::default();
+        for _ in 0..self.pieces.len() {
+            self.uf.add();
+        }
+        for i in 0..self.pieces.len() as u32 {
+            if self.pieces[i as usize].gone {
+                continue;
+            }
+            for o in self.below(&self.pieces[i as usize].body) {
+                if self.joined_by_rule(o, i) {
+                    self.uf.union(o, i);
+                }
+            }
+        }
+    }
+
+    /// Tests complex variant `variant` with one of its new pieces over
+    /// `c`: it applies when every `u` piece is laid as the rule has it and
+    /// every new piece fits among the model's voxels and cells the surface
+    /// passes through, stud-connected as the rule says.
+    fn try_complex(&mut self, variant: u32, c: Cell) -> bool {
+        let var = &self.rules.complex_variants()[variant as usize];
+        let u = self.layer_ldu;
+        for j in 0..var.v.len() {
+            let key = var.v[j].piece.body(Cell::new(0, 0, 0), u).key();
+            let origin = c.offset(-key.x, -key.y, -key.z);
+            let place = |p: &crate::grammar::complex::VariantPiece| {
+                let pl = Placement::new(p.part, origin.offset(p.at.x, p.at.y, p.at.z), p.rot);
+                (pl, pl.body(u))
+            };
+            // Every `u` piece laid exactly there.
+            let mut olds = Vec::with_capacity(var.u.len());
+            for p in &var.u {
+                let (pl, b) = place(p);
+                match self.owner_of(b.key()) {
+                    Some(o) if self.pieces[o as usize].placement == pl => olds.push(o),
+                    _ => break,
+                }
+            }
+            if olds.len() < var.u.len() {
+                continue;
+            }
+            // Every new piece fits, over voxels of the model mostly, none
+            // of them overlapping another.
+            let news: Vec<(Placement, Body)> = var.v.iter().map(|n| place(&n.piece)).collect();
+            let overlap = news.iter().enumerate().any(|(i, (_, a))| {
+                news[..i].iter().any(|(_, b)| a.bbox.intersects(&b.bbox))
+            });
+            if overlap {
+                continue;
+            }
+            let ok = news.iter().all(|(pl, b)| {
+                self.fits(pl, b, Reach::Near)
+                    .is_some_and(|(inside, near, _)| inside > 0 && inside >= 2 * near)
+            });
+            if !ok {
+                continue;
+            }
+            let g = self.groups.len() as u32;
+            let mut ids = Vec::with_capacity(news.len());
+            for (pl, b) in news {
+                let extra = self.fits(&pl, &b, Reach::Near).map_or(0, |(_, n, _)| n);
+                self.repairs.extra_cells += extra;
+                ids.push(self.place(pl, b, Some(g)));
+            }
+            self.groups.push(Group {
+                variant,
+                u: olds,
+                v: ids,
+            });
+            return true;
+        }
+        false
+    }
+}
