@@ -301,6 +301,47 @@ impl Layout<'_> {
         best.map(|(_, p, b)| (p, b))
     }
 
+    /// Fills the gaps between piece `p` and the pieces under it and over
+    /// it in its footprint: new pieces there join it to what is below and
+    /// above, so that neither it nor they must go into a gap too tight to
+    /// reach. Whether anything was laid.
+    pub fn fill_under(&mut self, p: &Placement, rng: &mut impl rand::Rng) -> bool {
+        let Some(id) = self.owner_of(p.body(self.layer_ldu).key()) else {
+            return false;
+        };
+        let body = self.pieces[id as usize].body;
+        let (_, _, nz) = self.must.dims();
+        let mut gap: Vec<Cell> = Vec::new();
+        // Under it, and over it: each column up to the next piece.
+        for (start, dz) in [(body.tubes, -1), (body.studs, 1)] {
+            for t in start.cells() {
+                let mut col = Vec::new();
+                let mut q = t.offset(0, 0, dz);
+                while q.z >= 0 && q.z < nz && self.owner_of(q).is_none() {
+                    col.push(q);
+                    q = q.offset(0, 0, dz);
+                }
+                if q.z >= 0 && q.z < nz {
+                    gap.extend(col);
+                }
+            }
+        }
+        gap.sort_by_key(|c| (c.z, c.y, c.x));
+        let mut laid = false;
+        for c in gap {
+            if self.owner_of(c).is_some() {
+                continue;
+            }
+            if let Some(cand) = self.fill_candidate(c, rng) {
+                self.repairs.extra_cells += cand.extra;
+                self.place(cand.placement, cand.body, None);
+                self.stats.fills += 1;
+                laid = true;
+            }
+        }
+        laid
+    }
+
     /// Keeps shape `s` at `origin` in `best` if it joins the body `root`
     /// to another (taking the place of piece `replaces`) with fewer cells
     /// outside the model.

@@ -83,19 +83,44 @@ pub(crate) struct Weights {
 
 impl Default for Weights {
     fn default() -> Self {
+        let mut w = Weights::base();
+        if let Ok(t) = std::env::var("BW_W") {
+            for kv in t.split(',') {
+                let (k, v) = kv.split_once('=').unwrap();
+                let v: f64 = v.parse().unwrap();
+                match k {
+                    "seam" => w.seam = v,
+                    "bridge_seam" => w.bridge_seam = v,
+                    "bridge" => w.bridge = v,
+                    "near" => w.near = v,
+                    "along" => w.along = v,
+                    "isolated" => w.isolated = v,
+                    "single" => w.single = v,
+                    "rule" => w.rule = v,
+                    "loose" => w.loose = v,
+                    _ => panic!("{k}"),
+                }
+            }
+        }
+        w
+    }
+}
+
+impl Weights {
+    fn base() -> Self {
         Weights {
             size: 1.0,
-            near: 2.0,
-            far: 3.0,
-            seam: 0.9,
+            near: 3.5,
+            far: 4.5,
+            seam: 2.0,
             bridge_seam: 0.3,
             bridge: 0.6,
             merge: 3.0,
-            loose: 4.0,
+            loose: 6.0,
             rule: 0.25,
             along: 0.4,
-            isolated: 1.5,
-            single: 1.0,
+            isolated: 3.0,
+            single: 2.5,
             noise: 0.05,
         }
     }
@@ -230,6 +255,22 @@ pub(crate) struct Layout<'a> {
     pub stats: SearchStats,
     pub repairs: Repairs,
     dims: (i32, i32, i32),
+    /// The layer being laid runs its long pieces along x.
+    along_x: bool,
+    /// The score of the layer being laid so far.
+    layer_score: f64,
+}
+
+/// What a layer's piece costs in its score, in voxels: the layer laid with
+/// fewer pieces scores higher.
+const PIECE_COST: f64 = 3.0;
+
+/// How a layer is scanned: long pieces along x or y, from which corner.
+#[derive(Debug, Clone, Copy)]
+struct Scan {
+    along_x: bool,
+    flip_x: bool,
+    flip_y: bool,
 }
 
 /// A scored candidate.
@@ -297,11 +338,9 @@ impl<'a> Layout<'a> {
             stats: SearchStats::default(),
             repairs: Repairs::default(),
             dims,
+            along_x: true,
+            layer_score: 0.0,
         }
-    }
-
-    pub fn dims(&self) -> (i32, i32, i32) {
-        self.dims
     }
 
     /// The piece owning `c`, if any (out of the grid: none).
@@ -318,33 +357,111 @@ impl<'a> Layout<'a> {
     }
 
     /// Lays every layer, bottom first, until done or `deadline`.
+    ///
+    /// Each layer is laid several ways (scanning from each corner, long
+    /// pieces along either axis, see [`Scan`]) and the way with the best
+    /// total score is kept: greedy choices made at one end of a course
+    /// decide where its seams fall at the other, so the layer as a whole is
+    /// compared.
     pub fn lay(&mut self, opts: &SearchOptions, dice: &mut Dice, deadline: Instant) {
-        let (nx, ny, nz) = self.dims;
+        let (_, _, nz) = self.dims;
         for z in 0..nz {
             if Instant::now() >= deadline {
-                let left: Vec<Cell> = (z..nz)
+                let left = (z..nz)
                     .flat_map(|k| self.must.layer_cells(k).collect::<Vec<_>>())
                     .filter(|&c| self.free(c))
-                    .collect();
-                self.repairs.budget_left_out = left.len();
+                    .count();
+                self.repairs.budget_left_out = left;
                 self.stats.budget_hit = true;
                 return;
             }
-            let rows = (z / self.course) % 2 == 1;
-            let (outer, inner) = if rows { (nx, ny) } else { (ny, nx) };
-            for a in 0..outer {
-                for b in 0..inner {
-                    let c = if rows {
-                        Cell::new(a, b, z)
-                    } else {
-                        Cell::new(b, a, z)
-                    };
-                    if self.must.get(c) && self.free(c) {
-                        self.cover(c, opts, dice);
+            if self.must.count_layer(z) == 0 {
+                continue;
+            }
+            let seed: u64 = dice.rules.gen();
+            // The course's own direction first: among equal layers it wins.
+            let along_x = (z / self.course) % 2 == 0;
+            let scans: Vec<Scan> = [along_x, !along_x]
+                .into_iter()
+                .flat_map(|ax| {
+                    (0..4).map(move |corner| Scan {
+                        along_x: ax,
+                        flip_x: corner & 1 == 1,
+                        flip_y: corner & 2 == 2,
+                    })
+                })
+                .collect();
+            let mut best: Option<(f64, usize)> = None;
+            if scans.len() > 1 {
+                let saved = (
+                    self.pieces.len(),
+                    self.groups.len(),
+                    self.uf.clone(),
+                    self.stats.clone(),
+                    self.repairs.clone(),
+                );
+                for (k, scan) in scans.iter().enumerate() {
+                    let score = self.lay_layer(z, *scan, opts, &mut Dice::new(seed ^ k as u64));
+                    if best.is_none_or(|b| score > b.0) {
+                        best = Some((score, k));
                     }
+                    self.undo_to(&saved);
+                }
+            }
+            let k = best.map_or(0, |b| b.1);
+            self.lay_layer(z, scans[k], opts, &mut Dice::new(seed ^ k as u64));
+        }
+    }
+
+    /// Takes out every piece laid since `saved` was taken.
+    fn undo_to(&mut self, saved: &(usize, usize, UnionFind, SearchStats, Repairs)) {
+        for id in saved.0..self.pieces.len() {
+            let body = self.pieces[id].body;
+            for q in body.cells() {
+                let i = self.must.index(q);
+                if self.owner[i] == id as u32 {
+                    self.owner[i] = NONE;
                 }
             }
         }
+        self.pieces.truncate(saved.0);
+        self.groups.truncate(saved.1);
+        self.uf = saved.2.clone();
+        self.stats = saved.3.clone();
+        self.repairs = saved.4.clone();
+    }
+
+    /// Lays layer `z` scanning as `scan` says; returns the layer's score:
+    /// its pieces' scores, less a fixed cost a piece.
+    fn lay_layer(&mut self, z: i32, scan: Scan, opts: &SearchOptions, dice: &mut Dice) -> f64 {
+        let (nx, ny, _) = self.dims;
+        self.along_x = scan.along_x;
+        self.layer_score = 0.0;
+        let xs: Vec<i32> = if scan.flip_x {
+            (0..nx).rev().collect()
+        } else {
+            (0..nx).collect()
+        };
+        let ys: Vec<i32> = if scan.flip_y {
+            (0..ny).rev().collect()
+        } else {
+            (0..ny).collect()
+        };
+        // Rows along the long pieces' direction, one after the other.
+        let (outer, inner) = if scan.along_x { (&ys, &xs) } else { (&xs, &ys) };
+        for &a in outer {
+            for &b in inner {
+                let c = if scan.along_x {
+                    Cell::new(b, a, z)
+                } else {
+                    Cell::new(a, b, z)
+                };
+                if self.must.get(c) && self.free(c) {
+                    self.cover(c, opts, dice);
+                }
+            }
+        }
+        self.layer_score
     }
 
     /// Covers the voxel `c` with the best piece, or a complex rule's
@@ -356,7 +473,8 @@ impl<'a> Layout<'a> {
             self.stats.complex_tried += 1;
             let n = self.rules.complex_variants().len();
             let variant = dice.complex.gen_range(0..n) as u32;
-            if self.try_complex(variant, c) {
+            if let Some(cells) = self.try_complex(variant, c) {
+                self.layer_score += cells as f64 * self.weights.size - PIECE_COST;
                 self.stats.complex_applied += 1;
                 return;
             }
@@ -365,6 +483,7 @@ impl<'a> Layout<'a> {
         match best {
             Some(b) => {
                 self.repairs.extra_cells += b.extra;
+                self.layer_score += b.score - PIECE_COST;
                 self.place(b.placement, b.body, None);
             }
             None => {
@@ -390,6 +509,11 @@ impl<'a> Layout<'a> {
             }
         }
         best
+    }
+
+    /// The best piece over the empty cell `c`, for filling a gap.
+    pub fn fill_candidate(&mut self, c: Cell, rng: &mut impl Rng) -> Option<Candidate> {
+        self.best(c, Reach::Far, rng)
     }
 
     /// The best candidate covering `c`, reaching as far as `reach`.
@@ -534,11 +658,8 @@ impl<'a> Layout<'a> {
             roots.dedup();
             score += w.merge * (roots.len() - 1) as f64;
         }
-        if let Some(long_x) = shape.long_x {
-            let rows = (z / self.course) % 2 == 1;
-            if long_x != rows {
-                score += w.along;
-            }
+        if shape.long_x == Some(self.along_x) {
+            score += w.along;
         }
         if shape.single {
             score -= w.single;
@@ -700,7 +821,7 @@ impl<'a> Layout<'a> {
     /// `c`: it applies when every `u` piece is laid as the rule has it and
     /// every new piece fits among the model's voxels and cells the surface
     /// passes through, stud-connected as the rule says.
-    fn try_complex(&mut self, variant: u32, c: Cell) -> bool {
+    fn try_complex(&mut self, variant: u32, c: Cell) -> Option<usize> {
         let var = &self.rules.complex_variants()[variant as usize];
         let u = self.layer_ldu;
         for j in 0..var.v.len() {
@@ -739,6 +860,7 @@ impl<'a> Layout<'a> {
                 continue;
             }
             let g = self.groups.len() as u32;
+            let cells: usize = news.iter().map(|(_, b)| b.volume() as usize).sum();
             let mut ids = Vec::with_capacity(news.len());
             for (pl, b) in news {
                 let extra = self.fits(&pl, &b, Reach::Near).map_or(0, |(_, n, _)| n);
@@ -750,8 +872,8 @@ impl<'a> Layout<'a> {
                 u: olds,
                 v: ids,
             });
-            return true;
+            return Some(cells);
         }
-        false
+        None
     }
 }

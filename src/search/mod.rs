@@ -102,6 +102,9 @@ pub struct SearchStats {
     pub widened: u64,
     /// Local repairs that joined a loose body to the rest.
     pub joins: u64,
+    /// Pieces laid in a gap under a piece that could not be put in place
+    /// otherwise.
+    pub fills: u64,
     /// Starting rules applied: a piece put on the ground that no piece
     /// before it joins.
     pub starts: u64,
@@ -254,7 +257,25 @@ pub fn build_guided(
     let mut dice = Dice::new(opts.seed);
     layout.lay(opts, &mut dice, deadline);
     layout.join(&mut dice.rules);
-    let (order, unreached) = derive::derive(&layout);
+    let (mut order, mut unreached) = derive::derive(&layout);
+    // A piece pressed on from below with pieces under it, too close to
+    // slide out of the way, cannot be put in place: fill the gap under it
+    // so that it rests on them instead, and derive again.
+    for _ in 0..PLACE_ROUNDS {
+        let blocked = unplaceable(&order, rules.layer_ldu());
+        if blocked.is_empty() || Instant::now() >= deadline {
+            break;
+        }
+        let mut changed = false;
+        for p in blocked {
+            changed |= layout.fill_under(&p, &mut dice.rules);
+        }
+        if !changed {
+            break;
+        }
+        layout.join(&mut dice.rules);
+        (order, unreached) = derive::derive(&layout);
+    }
     if order.is_empty() {
         if layout.stats.budget_hit {
             return Err(SearchError::Budget {
@@ -297,6 +318,23 @@ pub fn build_guided(
         repairs: layout.repairs,
         stats,
     })
+}
+
+/// Rounds of filling gaps under pieces that cannot be put in place.
+const PLACE_ROUNDS: usize = 6;
+
+/// The pieces of `order` the verifier would find cannot be put in place.
+fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<Placement> {
+    let pieces: Vec<Placement> = order.iter().map(|r| r.piece).collect();
+    let asm = crate::assembly::Assembly::from_order(&pieces, layer_ldu, crate::catalog::Color::RED);
+    crate::assembly::verify::verify(&asm, None)
+        .failures
+        .iter()
+        .filter_map(|f| match f {
+            crate::assembly::verify::Failure::NotPlaceable { piece, .. } => Some(pieces[*piece]),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The search's seeded random streams: one draws among scored candidates,
