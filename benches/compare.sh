@@ -29,7 +29,7 @@ seams = r["seams"]
 if what == "rules":
     print(f"| {name} | {label} | {r['pieces']} | {r['voxels_per_piece']} | {seams['continued']}/{seams['seams']} = {seams['fraction']:.2f} | {r['search']['nodes']} | {r['seconds']['search']} |")
 else:
-    print(f"| {name} | {label} | {r['pieces']} | {r['pieces'] - slopes} | {slopes} | {r['voxels']} | {r['repairs']['dropped_unbuildable']} | {seams['fraction']:.2f} | {r['seconds']['search']} |")
+    print(f"| {name} | {label} | {r['pieces']} | {r['pieces'] - slopes} | {slopes} | {r['voxels']} | {r['quality']['left_out']} | {seams['fraction']:.2f} | {r['seconds']['search']} |")
 PY
 }
 

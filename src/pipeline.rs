@@ -605,11 +605,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             slant: Some(&model.slant),
             surface: Some(&model.surface),
         };
-        let outcome = search::build_guided(&model.grid, guide, &rules, &search_opts)
-            .map_err(|reason| BuildError::Search {
-            file: file.clone(),
-            reason,
-        })?;
+        let outcome =
+            search::build_guided(&model.grid, guide, &rules, &search_opts).map_err(|reason| {
+                BuildError::Search {
+                    file: file.clone(),
+                    reason,
+                }
+            })?;
         let t = Instant::now();
         let order = search::placements(&outcome);
         let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
@@ -813,7 +815,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             ((voxels as f64 / own.max(1) as f64) * 100.0).round() / 100.0
         },
         seams,
-        quality: Quality::of(&assembly, &outcome.repairs, seams, opts.sizing, model.grid.count()),
+        quality: Quality::of(
+            &assembly,
+            &outcome.repairs,
+            seams,
+            opts.sizing,
+            model.grid.count(),
+        ),
         parts: parts.rows(),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: 1,

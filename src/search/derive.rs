@@ -15,10 +15,10 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use super::layout::Layout;
-use crate::geom::{Cell, CellBox};
-use crate::voxel::VoxelGrid;
 use super::{Anchor, Removal};
+use crate::geom::{Cell, CellBox};
 use crate::grammar::{Dir, Link, RuleId, RuleRef};
+use crate::voxel::VoxelGrid;
 
 /// The derivation of the laid pieces, and the pieces it cannot reach (no
 /// rule joins them to the rest, or no starting rule fits the ground).
@@ -53,9 +53,8 @@ pub(crate) fn derive(l: &Layout) -> (Vec<Removal>, Vec<u32>) {
     let mut queued = vec![false; n];
     let mut heap: BinaryHeap<Reverse<(i32, u32)>> = BinaryHeap::new();
     // Every piece on the ground a starting rule can put down.
-    let starts = |i: usize| {
-        alive(i) && z(i) == ground && l.rules.can_start(l.pieces[i].placement.part)
-    };
+    let starts =
+        |i: usize| alive(i) && z(i) == ground && l.rules.can_start(l.pieces[i].placement.part);
     for i in (0..n).filter(|&i| starts(i)) {
         queued[i] = true;
         heap.push(Reverse((z(i), i as u32)));

@@ -140,14 +140,26 @@ impl Layout<'_> {
                 for t in b.studs.cells() {
                     for ox in t.x - fx + 1..=t.x {
                         for oy in t.y - fy + 1..=t.y {
-                            self.consider(s, Cell::new(ox, oy, t.z + 1), None, (root, &roots), &mut best);
+                            self.consider(
+                                s,
+                                Cell::new(ox, oy, t.z + 1),
+                                None,
+                                (root, &roots),
+                                &mut best,
+                            );
                         }
                     }
                 }
                 for t in b.tubes.cells() {
                     for ox in t.x - fx + 1..=t.x {
                         for oy in t.y - fy + 1..=t.y {
-                            self.consider(s, Cell::new(ox, oy, t.z - h), None, (root, &roots), &mut best);
+                            self.consider(
+                                s,
+                                Cell::new(ox, oy, t.z - h),
+                                None,
+                                (root, &roots),
+                                &mut best,
+                            );
                         }
                     }
                 }
@@ -384,11 +396,21 @@ impl Layout<'_> {
             let a = &self.pieces[o as usize].placement;
             let u = self.layer_ldu;
             if lower {
-                self.book.joint(a, &placement, crate::grammar::Dir::Up, u).is_some()
-                    || self.book.joint(&placement, a, crate::grammar::Dir::Down, u).is_some()
+                self.book
+                    .joint(a, &placement, crate::grammar::Dir::Up, u)
+                    .is_some()
+                    || self
+                        .book
+                        .joint(&placement, a, crate::grammar::Dir::Down, u)
+                        .is_some()
             } else {
-                self.book.joint(a, &placement, crate::grammar::Dir::Down, u).is_some()
-                    || self.book.joint(&placement, a, crate::grammar::Dir::Up, u).is_some()
+                self.book
+                    .joint(a, &placement, crate::grammar::Dir::Down, u)
+                    .is_some()
+                    || self
+                        .book
+                        .joint(&placement, a, crate::grammar::Dir::Up, u)
+                        .is_some()
             }
         };
         for (list, lower) in [(&below, true), (&above, false)] {

@@ -110,9 +110,9 @@ impl Weights {
     fn base() -> Self {
         Weights {
             size: 1.0,
-            near: 3.5,
+            near: 2.0,
             far: 4.5,
-            seam: 2.0,
+            seam: 3.0,
             bridge_seam: 0.3,
             bridge: 0.6,
             merge: 3.0,
@@ -544,7 +544,12 @@ impl<'a> Layout<'a> {
     /// slanting the way the mesh does. Returns how many cells it fills of
     /// the model's voxels, of the cells the surface passes through, and of
     /// other empty cells.
-    fn fits(&self, placement: &Placement, body: &Body, reach: Reach) -> Option<(usize, usize, usize)> {
+    fn fits(
+        &self,
+        placement: &Placement,
+        body: &Body,
+        reach: Reach,
+    ) -> Option<(usize, usize, usize)> {
         let (mut inside, mut outside, mut far) = (0, 0, 0);
         for b in body.boxes() {
             for q in b.cells() {
@@ -665,8 +670,8 @@ impl<'a> Layout<'a> {
             score -= w.single;
         }
         let (seams, bridged, isolated) = self.seam_terms(&body, z);
-        score += w.bridge_seam * bridged as f64 - w.seam * seams as f64
-            - w.isolated * isolated as f64;
+        score +=
+            w.bridge_seam * bridged as f64 - w.seam * seams as f64 - w.isolated * isolated as f64;
         Some(Candidate {
             placement,
             body,
@@ -824,9 +829,20 @@ impl<'a> Layout<'a> {
     fn try_complex(&mut self, variant: u32, c: Cell) -> Option<usize> {
         let var = &self.rules.complex_variants()[variant as usize];
         let u = self.layer_ldu;
-        for j in 0..var.v.len() {
-            let key = var.v[j].piece.body(Cell::new(0, 0, 0), u).key();
-            let origin = c.offset(-key.x, -key.y, -key.z);
+        // Every way a new piece's bottom layer covers `c`.
+        let origins: Vec<Cell> = var
+            .v
+            .iter()
+            .flat_map(|n| {
+                let b = n.piece.body(Cell::new(0, 0, 0), u);
+                let z0 = b.bbox.min.z;
+                b.cells()
+                    .filter(move |k| k.z == z0)
+                    .map(move |k| c.offset(-k.x, -k.y, -k.z))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        for origin in origins {
             let place = |p: &crate::grammar::complex::VariantPiece| {
                 let pl = Placement::new(p.part, origin.offset(p.at.x, p.at.y, p.at.z), p.rot);
                 (pl, pl.body(u))
@@ -846,9 +862,10 @@ impl<'a> Layout<'a> {
             // Every new piece fits, over voxels of the model mostly, none
             // of them overlapping another.
             let news: Vec<(Placement, Body)> = var.v.iter().map(|n| place(&n.piece)).collect();
-            let overlap = news.iter().enumerate().any(|(i, (_, a))| {
-                news[..i].iter().any(|(_, b)| a.bbox.intersects(&b.bbox))
-            });
+            let overlap = news
+                .iter()
+                .enumerate()
+                .any(|(i, (_, a))| news[..i].iter().any(|(_, b)| a.bbox.intersects(&b.bbox)));
             if overlap {
                 continue;
             }

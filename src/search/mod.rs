@@ -284,11 +284,7 @@ pub fn build_guided(
                 total: fixed.count(),
             });
         }
-        let can_start: Vec<&str> = rules
-            .starts()
-            .iter()
-            .map(|s| s.part.spec().id.0)
-            .collect();
+        let can_start: Vec<&str> = rules.starts().iter().map(|s| s.part.spec().id.0).collect();
         return Err(SearchError::Rules(format!(
             "no piece on the ground has a starting rule (the file starts with {}); add a `start` line for a part that fits",
             can_start.join(", ")
@@ -298,9 +294,11 @@ pub fn build_guided(
         let b = layout.pieces[i as usize].body;
         let cells = b.cells().filter(|&q| fixed.get(q)).count();
         layout.remove(i);
-        layout
-            .repairs
-            .leave_out(b.bbox.min, cells, "no rule of the file joins it to the build");
+        layout.repairs.leave_out(
+            b.bbox.min,
+            cells,
+            "no rule of the file joins it to the build",
+        );
     }
     let (nx, ny, nz) = fixed.dims();
     let mut target = VoxelGrid::new(nx, ny, nz);
@@ -308,10 +306,7 @@ pub fn build_guided(
         target.set_body(&r.piece.body(rules.layer_ldu()), true);
     }
     let mut stats = layout.stats.clone();
-    stats.starts = order
-        .iter()
-        .filter(|r| r.anchor == Anchor::Start)
-        .count() as u64;
+    stats.starts = order.iter().filter(|r| r.anchor == Anchor::Start).count() as u64;
     Ok(SearchOutcome {
         order,
         voxels: target,
@@ -361,4 +356,3 @@ impl Dice {
 pub fn placements(outcome: &SearchOutcome) -> Vec<Placement> {
     outcome.order.iter().map(|r| r.piece).collect()
 }
-

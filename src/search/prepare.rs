@@ -300,7 +300,11 @@ fn shortest_bridge(
 fn cell_at(g: &VoxelGrid, i: usize) -> Cell {
     let (nx, ny, _) = g.dims();
     let (nx, ny) = (nx as usize, ny as usize);
-    Cell::new((i % nx) as i32, (i / nx % ny) as i32, (i / (nx * ny)) as i32)
+    Cell::new(
+        (i % nx) as i32,
+        (i / nx % ny) as i32,
+        (i / (nx * ny)) as i32,
+    )
 }
 
 /// Makes one-layer sheets two layers thick: a voxel with nothing directly
@@ -410,8 +414,8 @@ mod tests {
     #[test]
     fn islands_are_propped_or_bridged_never_dropped() {
         // A base, an island over it (a column), a speck beside it in the air
-        // at the grid's top (a bridge), and a corner-touching cell (joined as
-        // it is: the layout reaches across).
+        // at the grid's top (a bridge), and a cell touching the base at a
+        // corner (no island: the layout reaches across).
         let g = grid_with(&[
             bx(0, 0, 0, 6, 6, 2),
             bx(1, 1, 5, 3, 3, 2),
@@ -420,7 +424,7 @@ mod tests {
         ]);
         let (fixed, rep) = repair_islands(&g);
         assert_eq!(rep.left_out, 0);
-        assert_eq!(rep.joined_islands, 3);
+        assert_eq!(rep.joined_islands, 2);
         assert_eq!(components(&fixed).len(), 1);
         // The column is 3 cells; the speck's path is the rest.
         assert!(rep.support_voxels >= 3 + 8, "{rep:?}");

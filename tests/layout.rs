@@ -1,0 +1,255 @@
+//! The layout on real input: the whole shape built, interlocked, with few
+//! and big pieces, deterministic, with bricks, slopes and plates.
+
+use brickwright::assembly::{metrics, verify::verify, Assembly};
+use brickwright::catalog::{Color, Family};
+use brickwright::geom::Cell;
+use brickwright::grammar::{default_rules, RuleSet};
+use brickwright::search::{self, Anchor, Guide, SearchOptions, SearchOutcome};
+use brickwright::voxel::{voxelize, Sizing, VoxelGrid, VoxelizeOptions};
+
+fn rules(slopes: bool, plates: bool) -> RuleSet {
+    default_rules()
+        .restricted(|p| match p.spec().family() {
+            Family::Brick => true,
+            Family::Slope => slopes,
+            Family::Plate => plates,
+        })
+        .unwrap()
+}
+
+struct Built {
+    input: VoxelGrid,
+    out: SearchOutcome,
+    asm: Assembly,
+}
+
+fn build_fixture(name: &str, studs: u32, rules: &RuleSet, seed: u64) -> Built {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name);
+    let mesh = brickwright::mesh::load(&path).unwrap();
+    let vopts = VoxelizeOptions::default()
+        .with_sizing(Sizing::Studs(studs))
+        .with_layer_ldu(rules.layer_ldu());
+    let model = voxelize(&mesh, &vopts).unwrap();
+    let guide = Guide {
+        slant: Some(&model.slant),
+        surface: Some(&model.surface),
+    };
+    let out = search::build_guided(
+        &model.grid,
+        guide,
+        rules,
+        &SearchOptions::default().with_seed(seed),
+    )
+    .unwrap();
+    checked(model.grid, out, rules)
+}
+
+fn checked(input: VoxelGrid, out: SearchOutcome, rules: &RuleSet) -> Built {
+    let asm = Assembly::from_order(&search::placements(&out), rules.layer_ldu(), Color::RED);
+    let report = verify(&asm, Some(&out.voxels));
+    assert!(report.is_ok(), "{report}");
+    // Every voxel of the input is built.
+    for c in input.cells() {
+        assert!(out.voxels.get(c), "voxel {c:?} left out");
+    }
+    assert_eq!(out.repairs.left_out, 0);
+    // Every piece comes from a rule of the file or a starting rule on the
+    // ground.
+    for r in &out.order {
+        match r.anchor {
+            Anchor::Start => {
+                assert!(rules.can_start(r.piece.part));
+                assert_eq!(r.piece.origin.z, 0);
+            }
+            Anchor::Piece(_) => assert!(r.rule.is_some()),
+        }
+    }
+    Built { input, out, asm }
+}
+
+fn voxels_per_piece(b: &Built) -> f64 {
+    b.out.voxels.count() as f64 / b.asm.pieces.len() as f64
+}
+
+fn share_1x1(b: &Built) -> f64 {
+    let n = b
+        .asm
+        .pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().studs() == 1)
+        .count();
+    n as f64 / b.asm.pieces.len() as f64
+}
+
+#[test]
+fn the_mug_keeps_its_handle() {
+    let b = build_fixture("mug.obj", 24, &rules(false, false), 1);
+    // The handle is on the +x side, past the cup's wall: the cup spans
+    // about 8 of the model's 10.8 units, so columns past 17 studs hold
+    // handle only.
+    let (nx, ny, nz) = b.input.dims();
+    let handle: Vec<Cell> = b.input.cells().filter(|c| c.x >= 19).collect();
+    assert!(handle.len() > 20, "{} handle voxels", handle.len());
+    assert!(handle.iter().all(|&c| b.out.voxels.get(c)));
+    // Built by pieces, over several layers.
+    let layers: std::collections::BTreeSet<i32> = handle.iter().map(|c| c.z).collect();
+    assert!(layers.len() >= 4, "{layers:?} of {nx}x{ny}x{nz}");
+    assert!(voxels_per_piece(&b) >= 4.0, "{}", voxels_per_piece(&b));
+}
+
+#[test]
+fn the_arch_keeps_both_legs() {
+    let b = build_fixture("arch.obj", 24, &rules(false, false), 1);
+    let (nx, _, _) = b.input.dims();
+    let on_ground = |left: bool| {
+        b.asm.pieces.iter().any(|p| {
+            let bb = p.placement.body(24).bbox;
+            bb.min.z == 0
+                && if left {
+                    bb.min.x < nx / 4
+                } else {
+                    bb.min.x >= 3 * nx / 4
+                }
+        })
+    };
+    assert!(on_ground(true) && on_ground(false));
+}
+
+#[test]
+fn solid_fixtures_bond_with_few_big_pieces() {
+    let r = rules(false, false);
+    for (name, vpp_min) in [
+        ("house.obj", 8.0),
+        ("box.obj", 8.0),
+        ("mug.obj", 4.0),
+        ("arch.obj", 8.0),
+        ("staircase.obj", 8.0),
+        ("barn.obj", 8.0),
+        ("floating.obj", 8.0),
+    ] {
+        let b = build_fixture(name, 24, &r, 1);
+        let seams = metrics::seams(&b.asm);
+        assert!(seams.fraction <= 0.10, "{name}: {seams:?}");
+        assert!(share_1x1(&b) <= 0.10, "{name}: {} 1x1s", share_1x1(&b));
+        assert!(
+            voxels_per_piece(&b) >= vpp_min,
+            "{name}: {} voxels a piece",
+            voxels_per_piece(&b)
+        );
+        // The requested size is kept.
+        let bounds = b.out.voxels.bounds().unwrap();
+        assert!(
+            (bounds.sx.max(bounds.sy) - 24).abs() <= 1,
+            "{name}: {bounds:?}"
+        );
+    }
+}
+
+/// A rod one voxel thick stepping one stud sideways every layer: no two of
+/// its voxels share a face, yet it is built whole, each step bridged by a
+/// piece reaching over the one below.
+#[test]
+fn a_diagonal_rod_one_voxel_thick_is_built_whole() {
+    let r = rules(false, false);
+    let mut g = VoxelGrid::new(14, 3, 12);
+    for z in 0..12 {
+        g.set(Cell::new(z + 1, 1, z), true);
+    }
+    let out = search::build(&g, &r, &SearchOptions::default()).unwrap();
+    let b = checked(g, out, &r);
+    assert!(b.out.repairs.extra_cells > 0);
+    assert_eq!(b.out.repairs.joined_islands, 0);
+}
+
+/// A standing ring one voxel thick: its sides climb diagonally, its top
+/// hangs over the hole.
+#[test]
+fn a_ring_one_voxel_thick_is_built_whole() {
+    let r = rules(false, false);
+    let n = 16;
+    let mut g = VoxelGrid::new(n, 2, n);
+    let c = (n as f64 - 1.0) / 2.0;
+    for z in 0..n {
+        for x in 0..n {
+            let d = ((x as f64 - c).powi(2) + (z as f64 - c).powi(2)).sqrt();
+            if (d - c).abs() < 0.5 {
+                g.set(Cell::new(x, 0, z), true);
+            }
+        }
+    }
+    let out = search::build(&g, &r, &SearchOptions::default()).unwrap();
+    let b = checked(g, out, &r);
+    assert!(b.asm.pieces.len() > 10);
+}
+
+#[test]
+fn same_seed_same_layout_other_seed_still_sound() {
+    let r = rules(false, false);
+    let a = build_fixture("house.obj", 16, &r, 7);
+    let b = build_fixture("house.obj", 16, &r, 7);
+    assert_eq!(search::placements(&a.out), search::placements(&b.out));
+    let c = build_fixture("house.obj", 16, &r, 8);
+    assert_eq!(c.out.voxels.count(), a.out.voxels.count());
+}
+
+#[test]
+fn slopes_and_plates_lay_with_everything_else() {
+    let slopes = rules(true, false);
+    let b = build_fixture("barn.obj", 24, &slopes, 1);
+    let used = |b: &Built, f: Family| {
+        b.asm
+            .pieces
+            .iter()
+            .filter(|p| p.placement.part.spec().family() == f)
+            .count()
+    };
+    assert!(used(&b, Family::Slope) > 0, "no slopes on the barn's roof");
+    assert!(metrics::seams(&b.asm).fraction <= 0.15);
+    let plates = rules(false, true);
+    let b = build_fixture("house.obj", 16, &plates, 1);
+    assert!(used(&b, Family::Plate) > 0 && used(&b, Family::Brick) > 0);
+    // Bricks where the shape allows: most of the volume.
+    let brick_cells: i32 = b
+        .asm
+        .pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().family() == Family::Brick)
+        .map(|p| p.placement.body(8).volume())
+        .sum();
+    assert!(brick_cells as usize * 2 > b.out.voxels.count());
+}
+
+/// The shipped complex rules lay 2x4s over 2x4s: with the formula rules of
+/// `brickwright rules` (the 2x4 the biggest brick) they apply, one node
+/// adding both their pieces.
+#[test]
+fn complex_rules_apply_in_the_layout() {
+    let text = brickwright::grammar::rules_text(&brickwright::grammar::DEFAULT_ALPHABET, "default");
+    let r = RuleSet::parse(&text, "formula.rules".as_ref())
+        .unwrap()
+        .restricted(|p| p.spec().family() == Family::Brick)
+        .unwrap();
+    assert!(!r.complex_variants().is_empty());
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/box.obj");
+    let mesh = brickwright::mesh::load(&path).unwrap();
+    let model = voxelize(
+        &mesh,
+        &VoxelizeOptions::default().with_sizing(Sizing::Studs(24)),
+    )
+    .unwrap();
+    let out = search::build(
+        &model.grid,
+        &r,
+        &SearchOptions::default().with_complex_every(1),
+    )
+    .unwrap();
+    assert!(out.stats.complex_applied > 0, "{:?}", out.stats);
+    assert!(out
+        .order
+        .iter()
+        .any(|x| matches!(x.rule, Some(brickwright::grammar::RuleRef::Complex(_)))));
+    checked(model.grid, out, &r);
+}
