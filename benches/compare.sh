@@ -4,7 +4,7 @@
 #   benches/compare.sh rules MESH...    learned rule frequencies (the built-in
 #       rules) against the same rules with every weight 1 ("uniform"):
 #       vertical seams that continue into the course above (lower is
-#       stronger), voxels per piece, search nodes and seconds.
+#       stronger), voxels per piece and search seconds.
 #   benches/compare.sh slopes MESH...   bricks alone against bricks and
 #       slopes (--slopes): bricks, slopes, voxels left out, seconds.
 #
@@ -27,9 +27,9 @@ r = json.load(open(sys.argv[1])); name, label, what = sys.argv[2:5]
 slopes = sum(p["count"] for p in r["parts"] if p["name"].startswith("Slope"))
 seams = r["seams"]
 if what == "rules":
-    print(f"| {name} | {label} | {r['pieces']} | {r['voxels_per_piece']} | {seams['continued']}/{seams['seams']} = {seams['fraction']:.2f} | {r['search']['nodes']} | {r['seconds']['search']} |")
+    print(f"| {name} | {label} | {r['pieces']} | {r['voxels_per_piece']} | {seams['continued']}/{seams['seams']} = {seams['fraction']:.2f} | {r['seconds']['search']:.2f} |")
 else:
-    print(f"| {name} | {label} | {r['pieces']} | {r['pieces'] - slopes} | {slopes} | {r['voxels']} | {r['quality']['left_out']} | {seams['fraction']:.2f} | {r['seconds']['search']} |")
+    print(f"| {name} | {label} | {r['pieces']} | {r['pieces'] - slopes} | {slopes} | {r['voxels']} | {r['quality']['left_out']} | {seams['fraction']:.2f} | {r['seconds']['search']:.2f} |")
 PY
 }
 
@@ -42,8 +42,8 @@ rules)
   python3 - "$bin" "$out" "$studs" "${SEEDS:-1 2 3 4 5}" "$@" <<'PY'
 import json, subprocess, sys
 bin, out, studs, seeds, meshes = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(), sys.argv[5:]
-print(f"| mesh | weights | pieces | voxels/piece | seams continued | nodes | search s |  (mean of seeds {' '.join(seeds)})")
-print("|---|---|---|---|---|---|---|")
+print(f"| mesh | weights | pieces | voxels/piece | seams continued | search s |  (mean of seeds {' '.join(seeds)})")
+print("|---|---|---|---|---|---|")
 for mesh in meshes:
     name = mesh.rsplit("/", 1)[-1]
     for w in ["learned", "uniform"]:
@@ -55,8 +55,7 @@ for mesh in meshes:
             rows.append(json.load(open(f"{d}/report.json")))
         mean = lambda f: sum(f(r) for r in rows) / len(rows)
         print(f"| {name} | {w} | {mean(lambda r: r['pieces']):.0f} | {mean(lambda r: r['voxels_per_piece']):.2f} "
-              f"| {mean(lambda r: r['seams']['fraction']):.3f} | {mean(lambda r: r['search']['nodes']):.0f} "
-              f"| {mean(lambda r: r['seconds']['search']):.2f} |")
+              f"| {mean(lambda r: r['seams']['fraction']):.3f} | {mean(lambda r: r['seconds']['search']):.2f} |")
 PY
   ;;
 slopes)

@@ -253,3 +253,48 @@ fn complex_rules_apply_in_the_layout() {
         .any(|x| matches!(x.rule, Some(brickwright::grammar::RuleRef::Complex(_)))));
     checked(model.grid, out, &r);
 }
+
+/// The rules' weights steer the choice: a file that weighs the joints
+/// adding a 2x4 ten thousand times up lays more 2x4s, where other pieces
+/// would fit about as well.
+#[test]
+fn rule_weights_steer_the_choice() {
+    let text = brickwright::grammar::default_rules_text();
+    let heavy: String = text
+        .lines()
+        .map(|l| {
+            let mut t: Vec<String> = l.split_whitespace().map(String::from).collect();
+            if t.first().map(String::as_str) == Some("rule") && t[2] == "3001" {
+                let w: f64 = t[7].parse().unwrap();
+                t[7] = format!("{}", w * 1e4);
+                t.join(" ")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let plain = RuleSet::parse(&text, "default.rules".as_ref()).unwrap();
+    let heavy = RuleSet::parse(&heavy, "heavy.rules".as_ref()).unwrap();
+    let bricks = |r: RuleSet| {
+        r.restricted(|p| p.spec().family() == Family::Brick)
+            .unwrap()
+    };
+    let count = |b: &Built| {
+        b.asm
+            .pieces
+            .iter()
+            .filter(|p| p.placement.part.spec().id.0 == "3001")
+            .count()
+    };
+    for name in ["house.obj", "box.obj"] {
+        let a = build_fixture(name, 24, &bricks(plain.clone()), 1);
+        let b = build_fixture(name, 24, &bricks(heavy.clone()), 1);
+        assert!(
+            count(&b) > count(&a),
+            "{name}: {} 2x4s, {} with heavy joints",
+            count(&a),
+            count(&b)
+        );
+    }
+}

@@ -83,31 +83,6 @@ pub(crate) struct Weights {
 
 impl Default for Weights {
     fn default() -> Self {
-        let mut w = Weights::base();
-        if let Ok(t) = std::env::var("BW_W") {
-            for kv in t.split(',') {
-                let (k, v) = kv.split_once('=').unwrap();
-                let v: f64 = v.parse().unwrap();
-                match k {
-                    "seam" => w.seam = v,
-                    "bridge_seam" => w.bridge_seam = v,
-                    "bridge" => w.bridge = v,
-                    "near" => w.near = v,
-                    "along" => w.along = v,
-                    "isolated" => w.isolated = v,
-                    "single" => w.single = v,
-                    "rule" => w.rule = v,
-                    "loose" => w.loose = v,
-                    _ => panic!("{k}"),
-                }
-            }
-        }
-        w
-    }
-}
-
-impl Weights {
-    fn base() -> Self {
         Weights {
             size: 1.0,
             near: 2.0,
@@ -117,7 +92,7 @@ impl Weights {
             bridge: 0.6,
             merge: 3.0,
             loose: 6.0,
-            rule: 0.25,
+            rule: 0.6,
             along: 0.4,
             isolated: 3.0,
             single: 2.5,
