@@ -451,7 +451,7 @@
       try {
         window.history.replaceState(null, "", "#step=" + s);
       } catch (err) {
-        // Some browsers refuse history changes on file:// pages; the step still shows.
+        // Some browsers refuse history changes on local files; the step still shows.
       }
     }
   }

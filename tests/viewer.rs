@@ -1,0 +1,173 @@
+//! The step viewer page in a real browser: a fixture is built with
+//! `--formats html`, and headless Chromium (Debian's `chromium`, WebGL
+//! through SwiftShader, every host name unresolvable) opens the page at the
+//! first and the last step. The page must come up (`data-state="ready"` at
+//! the step the URL asks for), log nothing to the console, and draw the
+//! model: the two screenshots show it, with the current step outlined, and
+//! differ. The page itself must name no URL.
+//!
+//! Chromium is required: without it the test fails, unless
+//! `BRICKWRIGHT_SKIP_TOOLS=1` asks to skip (`.ci/run` installs it).
+
+#[allow(dead_code, reason = "each test crate uses the helpers it needs")]
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use brickwright::pipeline::{self, BuildOptions, Formats, Silent, Stability};
+use brickwright::voxel::Sizing;
+
+/// Builds `fixture` at `studs` with only the viewer page; its path and
+/// the step count.
+fn build_page(fixture: &str, studs: u32, out: &Path) -> (PathBuf, u32) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut opts = BuildOptions::new(root.join("fixtures").join(fixture));
+    opts.out_dir = out.to_path_buf();
+    opts.sizing = Sizing::Studs(studs);
+    opts.stability = Stability::Off;
+    opts.formats = Formats::parse("html").unwrap();
+    let built = pipeline::build(&opts, &Silent).unwrap_or_else(|e| panic!("{fixture}: {e}"));
+    let stem = fixture.rsplit_once('.').map_or(fixture, |(s, _)| s);
+    let page = out.join(format!("{stem}.html"));
+    assert!(
+        built.report.outputs.contains(&page.display().to_string()),
+        "{:?}",
+        built.report.outputs
+    );
+    (page, built.report.steps)
+}
+
+/// Headless Chromium on `url` with `args` added; its standard output and
+/// the page's console lines (from its log on standard error).
+fn chromium(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
+    let out = Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-gl=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--hide-scrollbars",
+            "--no-first-run",
+            "--disable-extensions",
+            "--disable-background-networking",
+            // Nothing can come from the network.
+            "--host-resolver-rules=MAP * ~NOTFOUND",
+            "--window-size=1000,750",
+            "--virtual-time-budget=8000",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(args)
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "chromium failed on {url}: {stderr}");
+    let console = stderr
+        .lines()
+        .filter(|l| l.contains(":CONSOLE"))
+        // Chromium's own note when it reads the frame back for a
+        // screenshot, not the page's.
+        .filter(|l| !l.contains("GPU stall due to ReadPixels"))
+        .map(str::to_string)
+        .collect();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), console)
+}
+
+/// The value of `attr` on the `<body>` tag of a dumped DOM.
+fn body_attr(dom: &str, attr: &str) -> Option<String> {
+    let tag = &dom[dom.find("<body")?..];
+    let tag = &tag[..tag.find('>')?];
+    let key = format!("{attr}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(tag[start..].split('"').next()?.to_string())
+}
+
+/// Pixels of the 3D view (the page's left part) in an RGB screenshot.
+fn view_pixels(png: &Path) -> Vec<[u8; 3]> {
+    let img = image::open(png)
+        .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
+        .to_rgb8();
+    assert_eq!(img.dimensions(), (1000, 750), "{}", png.display());
+    let mut px = Vec::new();
+    for y in 0..560 {
+        for x in 0..600 {
+            px.push(img.get_pixel(x, y).0);
+        }
+    }
+    px
+}
+
+fn far(a: [u8; 3], b: [u8; 3], by: i32) -> bool {
+    (0..3).any(|k| (i32::from(a[k]) - i32::from(b[k])).abs() > by)
+}
+
+#[test]
+fn chromium_shows_the_first_and_the_last_step() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (page, steps) = build_page("house.obj", 10, tmp.path());
+    assert!(steps >= 3, "{steps} steps");
+    let html = std::fs::read_to_string(&page).unwrap();
+    for needle in ["://", "src=", "href=", "url(", "@import"] {
+        assert!(!html.contains(needle), "the page holds `{needle}`");
+    }
+    if !common::required_tool("chromium", "chromium", "--version") {
+        return;
+    }
+    let profile = tmp.path().join("profile");
+    let background = [0xee, 0xf0, 0xf3];
+    let highlight = [0xff, 0x9e, 0x00];
+    let mut shots = Vec::new();
+    for step in [1, steps] {
+        let url = format!("file://{}#step={step}", page.display());
+        let (dom, console) = chromium(&profile, &url, &["--dump-dom"]);
+        assert_eq!(body_attr(&dom, "data-state").as_deref(), Some("ready"), "{url}");
+        assert_eq!(body_attr(&dom, "data-step"), Some(step.to_string()), "{url}");
+        assert!(console.is_empty(), "{url}: the console says {console:#?}");
+
+        let png = tmp.path().join(format!("step-{step}.png"));
+        let shot = format!("--screenshot={}", png.display());
+        let (_, console) = chromium(&profile, &url, &[&shot]);
+        assert!(console.is_empty(), "{url}: the console says {console:#?}");
+        let px = view_pixels(&png);
+        let model = px.iter().filter(|&&p| far(p, background, 24)).count();
+        let outlined = px.iter().filter(|&&p| !far(p, highlight, 40)).count();
+        assert!(model * 50 > px.len(), "step {step}: {model} model pixels");
+        assert!(outlined > 100, "step {step}: {outlined} highlight pixels");
+        if std::env::var_os("VIEWER_SHOTS").is_some() {
+            let keep = PathBuf::from(std::env::var_os("VIEWER_SHOTS").unwrap());
+            std::fs::create_dir_all(&keep).unwrap();
+            std::fs::copy(&png, keep.join(format!("step-{step}.png"))).unwrap();
+        }
+        shots.push((model, px));
+    }
+    let (first, last) = (&shots[0], &shots[1]);
+    assert!(last.0 > first.0, "the finished model covers more of the view");
+    let changed = first
+        .1
+        .iter()
+        .zip(&last.1)
+        .filter(|(a, b)| far(**a, **b, 24))
+        .count();
+    assert!(changed * 20 > first.1.len(), "{changed} pixels differ");
+}
+
+#[test]
+fn a_step_out_of_range_opens_the_nearest_step() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (page, steps) = build_page("wedge.stl", 8, tmp.path());
+    if !common::required_tool("chromium", "chromium", "--version") {
+        return;
+    }
+    let profile = tmp.path().join("profile");
+    for (hash, want) in [("#step=9999", steps), ("#step=0", 1), ("#other", 1)] {
+        let url = format!("file://{}{hash}", page.display());
+        let (dom, console) = chromium(&profile, &url, &["--dump-dom"]);
+        assert_eq!(body_attr(&dom, "data-state").as_deref(), Some("ready"), "{url}");
+        assert_eq!(body_attr(&dom, "data-step"), Some(want.to_string()), "{url}");
+        assert!(console.is_empty(), "{url}: {console:#?}");
+    }
+}
