@@ -124,8 +124,16 @@ fn chromium_shows_the_first_and_the_last_step() {
     for step in [1, steps] {
         let url = format!("file://{}#step={step}", page.display());
         let (dom, console) = chromium(&profile, &url, &["--dump-dom"]);
-        assert_eq!(body_attr(&dom, "data-state").as_deref(), Some("ready"), "{url}");
-        assert_eq!(body_attr(&dom, "data-step"), Some(step.to_string()), "{url}");
+        assert_eq!(
+            body_attr(&dom, "data-state").as_deref(),
+            Some("ready"),
+            "{url}"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-step"),
+            Some(step.to_string()),
+            "{url}"
+        );
         assert!(console.is_empty(), "{url}: the console says {console:#?}");
 
         let png = tmp.path().join(format!("step-{step}.png"));
@@ -145,7 +153,10 @@ fn chromium_shows_the_first_and_the_last_step() {
         shots.push((model, px));
     }
     let (first, last) = (&shots[0], &shots[1]);
-    assert!(last.0 > first.0, "the finished model covers more of the view");
+    assert!(
+        last.0 > first.0,
+        "the finished model covers more of the view"
+    );
     let changed = first
         .1
         .iter()
@@ -156,18 +167,36 @@ fn chromium_shows_the_first_and_the_last_step() {
 }
 
 #[test]
-fn a_step_out_of_range_opens_the_nearest_step() {
+fn the_url_chooses_the_step_and_the_exploded_view() {
     let tmp = tempfile::tempdir().unwrap();
     let (page, steps) = build_page("wedge.stl", 8, tmp.path());
     if !common::required_tool("chromium", "chromium", "--version") {
         return;
     }
     let profile = tmp.path().join("profile");
-    for (hash, want) in [("#step=9999", steps), ("#step=0", 1), ("#other", 1)] {
+    for (hash, want, exploded) in [
+        ("#step=9999", steps, "0"),
+        ("#step=0", 1, "0"),
+        ("#other", 1, "0"),
+        ("#step=2&exploded=1", 2, "1"),
+    ] {
         let url = format!("file://{}{hash}", page.display());
         let (dom, console) = chromium(&profile, &url, &["--dump-dom"]);
-        assert_eq!(body_attr(&dom, "data-state").as_deref(), Some("ready"), "{url}");
-        assert_eq!(body_attr(&dom, "data-step"), Some(want.to_string()), "{url}");
+        assert_eq!(
+            body_attr(&dom, "data-state").as_deref(),
+            Some("ready"),
+            "{url}"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-step"),
+            Some(want.to_string()),
+            "{url}"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-exploded").as_deref(),
+            Some(exploded),
+            "{url}"
+        );
         assert!(console.is_empty(), "{url}: {console:#?}");
     }
 }

@@ -38,33 +38,47 @@
 
   var steps = model.steps;
   var colors = model.colors.map(function (c) { return hexColor(c.rgb); });
-  // Instances grouped by part type, in build order: for any step the
-  // pieces shown are a prefix of each group, the current step's its tail.
+  // Instances grouped by part type, in build order. For each step the
+  // group's shown pieces are laid out in its instance buffer as three runs:
+  // earlier pieces whose studs are covered (drawn bare), the other earlier
+  // pieces (whole), and the current step's (whole, highlighted).
   var STRIDE = 18; // floats: rotation columns (9), position (3), explode offset (3), colour (3)
   var groups = model.parts.map(function (part) {
-    return { part: part, rows: [], steps: null, data: null };
+    return { part: part, rows: [], source: null, data: null, runs: [0, 0, 0] };
   });
   model.pieces.forEach(function (row) { groups[row[0]].rows.push(row); });
   groups.forEach(function (g) {
-    g.steps = new Int32Array(g.rows.length);
+    g.source = new Float32Array(g.rows.length * STRIDE);
     g.data = new Float32Array(g.rows.length * STRIDE);
     g.rows.forEach(function (row, i) {
-      var m = model.rotations[row[3]], c = colors[row[1]], o = i * STRIDE;
+      var m = model.rotations[row[3]], c = colors[row[1]];
       // Columns of the row-major LDraw matrix.
-      g.data.set([m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8],
-        row[4], row[5], row[6], row[7], row[8], row[9], c[0], c[1], c[2]], o);
-      g.steps[i] = row[2];
+      g.source.set([m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8],
+        row[4], row[5], row[6], row[7], row[8], row[9], c[0], c[1], c[2]], i * STRIDE);
     });
   });
-  // Pieces of the first k steps in group g: g.steps is sorted.
-  function upTo(g, k) {
-    var lo = 0, hi = g.steps.length;
-    while (lo < hi) {
-      var mid = (lo + hi) >> 1;
-      if (g.steps[mid] <= k) lo = mid + 1; else hi = mid;
-    }
-    return lo;
+  // Lays out every group's instances for step s; bare drawing only when
+  // the model is assembled (the exploded view opens the gaps).
+  function arrange(s, bare) {
+    groups.forEach(function (g) {
+      var runs = [[], [], []];
+      g.rows.forEach(function (row, i) {
+        if (row[2] > s) return;
+        var covered = bare && row[10] > 0 && row[10] <= s;
+        runs[row[2] === s ? 2 : covered ? 0 : 1].push(i);
+      });
+      var n = 0;
+      runs.forEach(function (run, k) {
+        run.forEach(function (i) {
+          g.data.set(g.source.subarray(i * STRIDE, (i + 1) * STRIDE), n * STRIDE);
+          n++;
+        });
+        g.runs[k] = run.length;
+      });
+    });
+    uploaded = false;
   }
+  var uploaded = false;
 
   // The box (min, max) of every piece, assembled (e = 0) or exploded (e = 1).
   function bounds(e) {
@@ -241,23 +255,29 @@
         gl.bufferData(target, data, gl.STATIC_DRAW);
         return b;
       };
-      var indices = p.index32 ? new Uint32Array(decode(p.indices)) : new Uint16Array(decode(p.indices));
+      var ints = function (b64) {
+        return p.index32 ? new Uint32Array(decode(b64)) : new Uint16Array(decode(b64));
+      };
+      var indices = ints(p.indices), bare = ints(p.bareIndices);
       return {
         positions: buffer(gl.ARRAY_BUFFER, new Float32Array(decode(p.positions))),
         normals: buffer(gl.ARRAY_BUFFER, new Float32Array(decode(p.normals))),
         indices: buffer(gl.ELEMENT_ARRAY_BUFFER, indices),
         count: indices.length,
+        bare: buffer(gl.ELEMENT_ARRAY_BUFFER, bare),
+        bareCount: bare.length,
         type: p.index32 ? gl.UNSIGNED_INT : gl.UNSIGNED_SHORT,
         instances: buffer(gl.ARRAY_BUFFER, g.data)
       };
     });
+    uploaded = false;
     gl.enable(gl.DEPTH_TEST);
     gl.enable(gl.CULL_FACE);
     return true;
   }
 
-  // Draws instances [from, to) of group i.
-  function drawRange(i, from, to) {
+  // Draws instances [from, to) of group i, whole or bare.
+  function drawRange(i, from, to, bare) {
     if (to <= from) return;
     var m = meshes[i];
     gl.bindBuffer(gl.ARRAY_BUFFER, m.positions);
@@ -268,8 +288,8 @@
     for (var a = 0; a < 6; a++) {
       gl.vertexAttribPointer(2 + a, 3, gl.FLOAT, false, STRIDE * 4, (from * STRIDE + 3 * a) * 4);
     }
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, m.indices);
-    draw.elements(m.count, m.type, to - from);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, bare ? m.bare : m.indices);
+    draw.elements(bare ? m.bareCount : m.count, m.type, to - from);
   }
 
   var state = { step: 1, explode: 0, stats: null };
@@ -311,26 +331,36 @@
       gl.enableVertexAttribArray(a);
       draw.divisor(a, 1);
     }
-    var ranges = groups.map(function (g) { return [upTo(g, state.step - 1), upTo(g, state.step)]; });
+    if (!uploaded) {
+      groups.forEach(function (g, i) {
+        gl.bindBuffer(gl.ARRAY_BUFFER, meshes[i].instances);
+        gl.bufferSubData(gl.ARRAY_BUFFER, 0, g.data);
+      });
+      uploaded = true;
+    }
+    var ranges = groups.map(function (g) {
+      return [g.runs[0], g.runs[0] + g.runs[1], g.runs[0] + g.runs[1] + g.runs[2]];
+    });
     // Earlier steps as built; the current step tinted, then outlined: the
     // back faces of a slightly grown copy, a rim wherever it shows.
     gl.uniform1f(loc.uGrow, 0);
     gl.uniform1i(loc.uMode, 0);
     groups.forEach(function (g, i) {
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, 0, ranges[i][0]);
+      drawRange(i, 0, ranges[i][0], true);
+      drawRange(i, ranges[i][0], ranges[i][1], false);
     });
     gl.uniform1i(loc.uMode, 1);
     groups.forEach(function (g, i) {
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, ranges[i][0], ranges[i][1]);
+      drawRange(i, ranges[i][1], ranges[i][2], false);
     });
     gl.cullFace(gl.FRONT);
     gl.uniform1i(loc.uMode, 2);
     gl.uniform1f(loc.uGrow, Math.min(Math.max(2.2 * worldPerPixel(), 0.6), 8));
     groups.forEach(function (g, i) {
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, ranges[i][0], ranges[i][1]);
+      drawRange(i, ranges[i][1], ranges[i][2], false);
     });
     gl.cullFace(gl.BACK);
     for (a = 2; a < 8; a++) draw.divisor(a, 0);
@@ -433,6 +463,7 @@
       row.cells[2].textContent = have + " / " + allCounts[key];
       row.className = now[key] ? "now" : have === allCounts[key] ? "done" : "";
     });
+    arrange(s, state.explode === 0);
     body.setAttribute("data-step", String(s));
     body.setAttribute("data-placed", String(placed));
     requestRender();
@@ -442,6 +473,9 @@
     var m = /(?:^#|&)step=(-?\d+)/.exec(window.location.hash || "");
     return m ? parseInt(m[1], 10) : null;
   }
+  function writeHash() {
+    window.history.replaceState(null, "", "#step=" + state.step + (ui.explode.checked ? "&exploded=1" : ""));
+  }
   function setStep(s, updateHash) {
     s = Math.max(1, Math.min(steps || 1, Math.round(s) || 1));
     if (s === state.step && body.hasAttribute("data-step")) return;
@@ -449,7 +483,7 @@
     showStep();
     if (updateHash) {
       try {
-        window.history.replaceState(null, "", "#step=" + s);
+        writeHash();
       } catch (err) {
         // Some browsers refuse history changes on local files; the step still shows.
       }
@@ -462,8 +496,13 @@
     var from = state.explode, to = on ? 1 : 0;
     var fromCam = { target: camera.target.slice(), dist: camera.dist }, goal = fitted(layouts[to]);
     ui.explode.checked = on;
+    body.setAttribute("data-exploded", on ? "1" : "0");
+    try { writeHash(); } catch (err) { /* as in setStep */ }
+    // Whole pieces while anything is apart; bare again once assembled.
+    arrange(state.step, false);
     animate(450, function (t) {
       state.explode = lerp(from, to, t);
+      if (t >= 1 && to === 0) arrange(state.step, true);
       camera.target = [0, 1, 2].map(function (k) { return lerp(fromCam.target[k], goal.target[k], t); });
       camera.dist = lerp(fromCam.dist, goal.dist, t);
     });
@@ -588,6 +627,11 @@
   ui.footer.textContent = "Made by " + model.generator + ". Drawn with WebGL in this page; it needs no network.";
 
   if (!initGL()) return;
+  if (/(?:^#|&)exploded=1/.test(window.location.hash || "")) {
+    ui.explode.checked = true;
+    state.explode = 1;
+  }
+  body.setAttribute("data-exploded", ui.explode.checked ? "1" : "0");
   resetView();
   var start = stepFromHash();
   setStep(start === null ? 1 : start, false);
