@@ -200,3 +200,90 @@ fn the_url_chooses_the_step_and_the_exploded_view() {
         assert!(console.is_empty(), "{url}: {console:#?}");
     }
 }
+
+/// A page beside the viewer that drives it in a frame the way a person
+/// would (keys, buttons, the slider, the address, a drag, the wheel, the
+/// explode toggle) and writes what the viewer showed after each action
+/// into its own `<body data-log>`.
+const HARNESS: &str = r##"<!DOCTYPE html>
+<html><body data-log="">
+<iframe id="f" width="900" height="650"></iframe>
+<script>
+var f = document.getElementById("f"), log = [];
+function note(what) {
+  var b = f.contentDocument.body;
+  log.push(what + "=" + b.getAttribute("data-step") + "/" + b.getAttribute("data-exploded") +
+    "/" + b.getAttribute("data-state") + "/" + f.contentWindow.location.hash);
+}
+function key(k) {
+  f.contentWindow.dispatchEvent(new f.contentWindow.KeyboardEvent("keydown", { key: k, bubbles: true }));
+}
+function pointer(type, x, y, buttons) {
+  var w = f.contentWindow, c = f.contentDocument.getElementById("view");
+  c.dispatchEvent(new w.PointerEvent(type, { pointerId: 7, clientX: x, clientY: y, button: 0,
+    buttons: buttons, bubbles: true, cancelable: true }));
+}
+f.onload = function () {
+  var d = f.contentDocument, w = f.contentWindow;
+  note("open");
+  key("ArrowRight"); note("right");
+  key("ArrowRight"); note("right");
+  key("ArrowLeft"); note("left");
+  d.getElementById("next").click(); note("next");
+  d.getElementById("prev").click(); note("prev");
+  key("End"); note("end");
+  d.getElementById("first").click(); note("first");
+  var s = d.getElementById("slider");
+  s.value = "3"; s.dispatchEvent(new w.Event("input", { bubbles: true })); note("slider");
+  pointer("pointerdown", 300, 300, 1); pointer("pointermove", 360, 320, 1); pointer("pointerup", 360, 320, 0);
+  d.getElementById("view").dispatchEvent(new w.WheelEvent("wheel", { deltaY: 120, bubbles: true, cancelable: true }));
+  note("drag");
+  d.getElementById("explode").click(); note("explode");
+  w.location.hash = "#step=2";
+  setTimeout(function () {
+    note("hash");
+    document.body.setAttribute("data-log", log.join(" "));
+  }, 300);
+};
+f.src = "PAGE#step=1";
+</script>
+</body></html>
+"##;
+
+#[test]
+fn keys_buttons_slider_and_address_move_between_steps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (page, steps) = build_page("house.obj", 10, tmp.path());
+    assert!(steps >= 4, "{steps} steps");
+    if !common::required_tool("chromium", "chromium", "--version") {
+        return;
+    }
+    let harness = tmp.path().join("harness.html");
+    let name = page.file_name().unwrap().to_string_lossy();
+    std::fs::write(&harness, HARNESS.replace("PAGE", &name)).unwrap();
+    let url = format!("file://{}", harness.display());
+    // The frame's document is readable only with file access between files.
+    let profile = tmp.path().join("profile");
+    let (dom, console) = chromium(
+        &profile,
+        &url,
+        &["--allow-file-access-from-files", "--dump-dom"],
+    );
+    assert!(console.is_empty(), "the console says {console:#?}");
+    let log = body_attr(&dom, "data-log").unwrap_or_default();
+    let want = [
+        "open=1/0/ready/#step=1".to_string(),
+        "right=2/0/ready/#step=2".into(),
+        "right=3/0/ready/#step=3".into(),
+        "left=2/0/ready/#step=2".into(),
+        "next=3/0/ready/#step=3".into(),
+        "prev=2/0/ready/#step=2".into(),
+        format!("end={steps}/0/ready/#step={steps}"),
+        "first=1/0/ready/#step=1".into(),
+        "slider=3/0/ready/#step=3".into(),
+        "drag=3/0/ready/#step=3".into(),
+        "explode=3/1/ready/#step=3&amp;exploded=1".into(),
+        "hash=2/1/ready/#step=2".into(),
+    ];
+    assert_eq!(log.split(' ').collect::<Vec<_>>(), want, "{dom}");
+}
