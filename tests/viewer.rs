@@ -199,6 +199,12 @@ fn the_url_chooses_the_step_and_the_exploded_view() {
         );
         assert!(console.is_empty(), "{url}: {console:#?}");
     }
+    // Without WebGL the page says so, and the step lists still work.
+    let url = format!("file://{}#step=2", page.display());
+    let (dom, _) = chromium(&profile, &url, &["--disable-3d-apis", "--dump-dom"]);
+    assert_eq!(body_attr(&dom, "data-state").as_deref(), Some("error"));
+    assert_eq!(body_attr(&dom, "data-step").as_deref(), Some("2"));
+    assert!(dom.contains("needs WebGL"), "{dom}");
 }
 
 /// A page beside the viewer that drives it in a frame the way a person

@@ -218,7 +218,9 @@
       gl = canvas.getContext("webgl", opts) || canvas.getContext("experimental-webgl", opts);
       var ext = gl && gl.getExtension("ANGLE_instanced_arrays");
       if (!ext) {
-        fail("This page needs WebGL with instanced drawing, which this browser does not offer.");
+        gl = null;
+        fail("The 3D view needs WebGL with instanced drawing, which this browser does not offer " +
+          "(or has turned off); the parts lists still work.");
         return false;
       }
       draw = {
@@ -626,7 +628,8 @@
     (model.colors.length === 1 ? " colour" : " colours");
   ui.footer.textContent = "Made by " + model.generator + ". Drawn with WebGL in this page; it needs no network.";
 
-  if (!initGL()) return;
+  // Without WebGL the lists and the step controls still work.
+  var drawing = initGL();
   if (/(?:^#|&)exploded=1/.test(window.location.hash || "")) {
     ui.explode.checked = true;
     state.explode = 1;
@@ -635,6 +638,7 @@
   resetView();
   var start = stepFromHash();
   setStep(start === null ? 1 : start, false);
+  if (!drawing) return;
 
   // "#bench=N": draw N frames at once, turning the model, and report the
   // frame rate (in the console and as the body's data-fps).
