@@ -31,8 +31,14 @@
 //!   exactly as the `.ldr` line has it, the exploded-view offset, and the
 //!   step from which every stud of the piece is covered (0 if never).
 //!
-//! A 5,000-piece build is about 55 bytes a piece, some 300 kB, and the
-//! viewer draws it in a few instanced calls per part type.
+//! A piece takes about 52 bytes, a part type 10 to 70 kB of mesh: the
+//! 5,701-piece build of a 64-stud box (11 part types) makes a 578 kB page.
+//! The viewer draws it in a few instanced calls per part type.
+//!
+//! The address picks the view: `page.html#step=12` opens at step 12 (out
+//! of range goes to the nearest step), `&exploded=1` exploded, and the
+//! address follows the viewer. Without WebGL the page says so, and the step
+//! controls and parts lists still work.
 //!
 //! # Covered studs
 //!
