@@ -510,6 +510,7 @@
     });
   }
   function resetView() {
+    moved = false;
     var goal = fitted(layouts[ui.explode.checked ? 1 : 0]);
     camera.target = goal.target;
     camera.dist = goal.dist;
@@ -517,17 +518,29 @@
     camera.el = 30 * Math.PI / 180;
     requestRender();
   }
+  // Until the camera is moved by hand, a resized view refits the model.
+  var moved = false;
+  function refit() {
+    if (moved || animation) return requestRender();
+    var goal = fitted(layouts[ui.explode.checked ? 1 : 0]);
+    camera.target = goal.target;
+    camera.dist = goal.dist;
+    requestRender();
+  }
   function orbit(dx, dy) {
+    moved = true;
     camera.az -= dx * 0.008;
     camera.el = Math.max(-1.55, Math.min(1.55, camera.el + dy * 0.008));
   }
   function pan(dx, dy) {
+    moved = true;
     var view = lookAt(eye(), camera.target, UP), wpp = worldPerPixel();
     for (var k = 0; k < 3; k++) {
       camera.target[k] += (-dx * view[4 * k] + dy * view[4 * k + 1]) * wpp;
     }
   }
   function zoom(factor) {
+    moved = true;
     var r = layouts[state.explode > 0.5 ? 1 : 0].radius;
     camera.dist = Math.max(r * 0.05, Math.min(r * 20, camera.dist * factor));
   }
@@ -615,8 +628,8 @@
   canvas.addEventListener("webglcontextrestored", function () {
     if (initGL()) requestRender();
   });
-  if (window.ResizeObserver) new ResizeObserver(requestRender).observe(canvas);
-  else window.addEventListener("resize", requestRender);
+  if (window.ResizeObserver) new ResizeObserver(refit).observe(canvas);
+  else window.addEventListener("resize", refit);
 
   // ---------------------------------------------------------------- start
 
