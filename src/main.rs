@@ -205,7 +205,8 @@ struct BuildArgs {
     #[arg(long, value_enum)]
     condition: Option<ConditionArg>,
     /// The files to write, comma-separated: ldr, glb, exploded-glb, gltf, bricklink, csv,
-    /// steps, png, exploded-png, pdf, or all (every one but gltf); report.json is always written.
+    /// steps, png, exploded-png, pdf, stress, html (the step viewer page), or all (every one
+    /// but gltf); report.json is always written.
     #[arg(long, default_value = "all", value_parser = parse_formats)]
     formats: pipeline::Formats,
     /// The booklet's layout (page size, margins, steps a page, fonts, colours): a TOML file

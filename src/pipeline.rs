@@ -22,6 +22,7 @@ use crate::booklet::template::TemplateError;
 use crate::booklet::Template;
 use crate::catalog::{Color, Family, Palette};
 use crate::export::gltf::{write_gltf, Container, GltfOptions};
+use crate::export::html::{write_html, HtmlOptions};
 use crate::export::partslist::{
     write_bricklink, write_rebrickable_csv, Condition, PartsList, PartsRow,
 };
@@ -117,11 +118,13 @@ pub enum Format {
     /// the share of its clutch used (green none, red all); needs the
     /// stability check.
     Stress,
+    /// `<stem>.html`: the interactive step viewer, one self-contained page.
+    Html,
 }
 
 impl Format {
     /// Every format, in the order files are written.
-    pub const ALL: [Format; 11] = [
+    pub const ALL: [Format; 12] = [
         Format::Ldr,
         Format::Glb,
         Format::ExplodedGlb,
@@ -133,6 +136,7 @@ impl Format {
         Format::ExplodedPng,
         Format::Pdf,
         Format::Stress,
+        Format::Html,
     ];
 
     /// Whether `--formats all` (and the default) includes it: every format
@@ -155,6 +159,7 @@ impl Format {
             Format::ExplodedPng => "exploded-png",
             Format::Pdf => "pdf",
             Format::Stress => "stress",
+            Format::Html => "html",
         }
     }
 
@@ -172,6 +177,7 @@ impl Format {
             Format::ExplodedPng => format!("{stem}-exploded.png"),
             Format::Pdf => format!("{stem}.pdf"),
             Format::Stress => format!("{stem}-stress.png"),
+            Format::Html => format!("{stem}.html"),
         }
     }
 }
@@ -866,6 +872,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 files.add(&path, |w| w.write_all(&png))
             }
             Format::Csv => files.add(&path, |w| write_rebrickable_csv(w, &parts)),
+            Format::Html => files.add(&path, |w| {
+                write_html(w, &assembly, &HtmlOptions::default().with_name(&stem))
+            }),
             Format::Steps | Format::Png | Format::ExplodedPng | Format::Pdf => {
                 let Some((rendered, booklet)) = &rendered else {
                     unreachable!("pictures are rendered when a pictured format is asked for")

@@ -156,6 +156,7 @@ fn build_and_verify(name: &str) {
         "-exploded.png",
         ".pdf",
         "-stress.png",
+        ".html",
     ]
     .iter()
     .map(|suffix| match *suffix {

@@ -11,10 +11,13 @@
 //! - [`gltf`] writes a glTF 2.0 scene (`.glb` or `.gltf`): a node per
 //!   piece, a mesh per part and colour, LEGO-coloured materials and a build
 //!   animation.
+//! - [`html`] writes the interactive step viewer: one self-contained web
+//!   page with the model, a WebGL renderer and the parts lists inlined.
 //! - [`partslist`] writes the parts lists for buying the bricks: a
 //!   BrickLink wanted list and a Rebrickable CSV.
 
 pub mod explode;
 pub mod gltf;
+pub mod html;
 pub mod partmesh;
 pub mod partslist;
