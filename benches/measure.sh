@@ -23,7 +23,7 @@ import json, sys
 r = json.load(open(sys.argv[1])); secs, mem = open(sys.argv[2]).read().split()[-2:]
 q = r["quality"]
 print(f"| {sys.argv[3]} | {sys.argv[4]} | {r['voxels']} | {r['pieces']} | {q['voxels_per_piece']} | {q['left_out']} "
-      f"| {100 * q['seams_continued']:.1f}% | {100 * q['share_1x1']:.1f}% | {r['seconds']['search']} | {secs} | {int(mem) / 1024:.0f} |")
+      f"| {100 * q['seams_continued']:.1f}% | {100 * q['share_1x1']:.1f}% | {r['seconds']['search']:.2f} | {secs} | {int(mem) / 1024:.0f} |")
 PY
     else
       printf '| %s | %s | failed: %s |\n' "$name" "$n" "$(tr '\n' ' ' < "$out/err")"
