@@ -256,10 +256,21 @@ impl Progress for Spinners {
     }
 }
 
-fn run_build(a: BuildArgs) -> Result<()> {
-    if !(a.time_budget.is_finite() && a.time_budget > 0.0) {
-        anyhow::bail!("--time-budget must be a positive number of seconds");
+/// The longest time budget kept: about 31 years; more is taken as this
+/// (no budget, in effect) rather than overflowing a clock.
+const MAX_BUDGET_SECS: f64 = 1e9;
+
+/// A `--...-budget` value: positive seconds, saturated at [`MAX_BUDGET_SECS`].
+fn budget(option: &str, secs: f64) -> Result<Duration> {
+    if !(secs.is_finite() && secs > 0.0) {
+        anyhow::bail!("{option} must be a positive number of seconds, not {secs}");
     }
+    Ok(Duration::from_secs_f64(secs.min(MAX_BUDGET_SECS)))
+}
+
+fn run_build(a: BuildArgs) -> Result<()> {
+    let time_budget = budget("--time-budget", a.time_budget)?;
+    let stability_budget = budget("--stability-budget", a.stability_budget)?;
     let mut opts = BuildOptions::new(&a.input);
     opts.out_dir = a.output;
     opts.sizing = match (a.studs, a.height) {
@@ -288,10 +299,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     });
     opts.formats = a.formats;
     opts.template = a.template;
-    if !(a.stability_budget.is_finite() && a.stability_budget > 0.0) {
-        anyhow::bail!("--stability-budget must be a positive number of seconds");
-    }
-    opts.stability_budget = Duration::from_secs_f64(a.stability_budget);
+    opts.stability_budget = stability_budget;
     opts.supports = !a.no_supports;
     opts.stability = match a.stability {
         StabilityArg::Repair => pipeline::Stability::Repair,
@@ -301,7 +309,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     opts.search = opts
         .search
         .with_seed(a.seed)
-        .with_time_budget(Duration::from_secs_f64(a.time_budget))
+        .with_time_budget(time_budget)
         .with_complex_every(a.complex_every);
     let spinners = Spinners {
         bar: Default::default(),

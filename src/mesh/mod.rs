@@ -30,6 +30,7 @@
 //! # Ok::<(), mesh::MeshError>(())
 //! ```
 
+mod buffers;
 mod gltf;
 mod obj;
 mod stl;
