@@ -770,10 +770,7 @@ mod tests {
         const DEPTH: usize = 100_000;
         let mut text = String::new();
         for i in 0..DEPTH {
-            text += &format!(
-                "0 FILE m{i}\n1 16 0 -24 0 1 0 0 0 1 0 0 0 1 m{}\n",
-                i + 1
-            );
+            text += &format!("0 FILE m{i}\n1 16 0 -24 0 1 0 0 0 1 0 0 0 1 m{}\n", i + 1);
         }
         text += &format!("0 FILE m{DEPTH}\n1 4 0 -24 0 1 0 0 0 1 0 0 0 1 3001.dat\n");
         // On a small thread stack, as a recursive reader would overflow it.

@@ -465,7 +465,13 @@ mod tests {
         std::os::unix::fs::symlink(dir.path().join("outside.bin"), model.join("out.bin")).unwrap();
         let fifo = model.join("fifo.bin");
         let made = std::process::Command::new("mkfifo").arg(&fifo).status();
-        for uri in ["/dev/zero", "/dev/urandom", "zero.bin", "out.bin", "fifo.bin"] {
+        for uri in [
+            "/dev/zero",
+            "/dev/urandom",
+            "zero.bin",
+            "out.bin",
+            "fifo.bin",
+        ] {
             if uri == "fifo.bin" && !made.as_ref().is_ok_and(|s| s.success()) {
                 continue;
             }
@@ -480,7 +486,9 @@ mod tests {
             assert!(load_with_uri(dir.path(), "null.bin").is_err());
         }
         if made.is_ok_and(|s| s.success()) {
-            let e = load_with_uri(dir.path(), "fifo.bin").unwrap_err().to_string();
+            let e = load_with_uri(dir.path(), "fifo.bin")
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("not a regular file"), "{e}");
         }
     }
@@ -497,7 +505,9 @@ mod tests {
         check_transformed_cube(&load_with_uri(dir.path(), "long.bin").unwrap());
         // Shorter than declared: an error naming both lengths.
         std::fs::write(model.join("short.bin"), &cube_buffer()[..100]).unwrap();
-        let e = load_with_uri(dir.path(), "short.bin").unwrap_err().to_string();
+        let e = load_with_uri(dir.path(), "short.bin")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("100") && e.contains("168"), "{e}");
     }
 }

@@ -125,7 +125,10 @@ mod tests {
         b[80..84].copy_from_slice(&5u32.to_le_bytes());
         let f = write("low.stl", &b);
         let e = load(&f.path).unwrap_err().to_string();
-        assert!(e.contains("low.stl") && e.contains("says 5 triangles but the file holds 12"), "{e}");
+        assert!(
+            e.contains("low.stl") && e.contains("says 5 triangles but the file holds 12"),
+            "{e}"
+        );
         // Trailing bytes short of a triangle are padding.
         let mut b = binary_cube();
         b.extend([0u8; 20]);

@@ -133,8 +133,12 @@ pub fn step_paths(dir: &Path, steps: usize) -> Vec<PathBuf> {
 
 /// Removes `step-NNN.png` files of an earlier, longer run from `dir`, so
 /// the directory holds exactly this build's steps. Best effort: a file
-/// that cannot be removed stays.
+/// that cannot be removed stays. A `dir` that is a symbolic link is left
+/// alone: nothing outside the output folder is deleted.
 pub fn remove_stale_steps(dir: &Path, steps: usize) {
+    if crate::fsutil::refuse_link(dir).is_err() {
+        return;
+    }
     let keep: std::collections::BTreeSet<PathBuf> = step_paths(dir, steps).into_iter().collect();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
