@@ -760,7 +760,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         seams: crate::assembly::metrics::seams(&assembly),
         parts: parts.rows(),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
-        components: 1,
+        components: crate::assembly::verify::components(&assembly),
         steps: assembly.step_count(),
         booklet_pages: formats
             .contains(Format::Pdf)

@@ -317,6 +317,17 @@ pub fn connections(bodies: &[Body]) -> Vec<Vec<usize>> {
     neighbours
 }
 
+/// Number of stud-connected components of `asm`: 1 for a build that holds
+/// together, 0 for no pieces.
+pub fn components(asm: &Assembly) -> usize {
+    let bodies: Vec<Body> = asm
+        .pieces
+        .iter()
+        .map(|p| p.placement.body(asm.layer_ldu))
+        .collect();
+    count_components(&connections(&bodies))
+}
+
 /// Number of connected components of the graph (0 for no pieces).
 fn count_components(neighbours: &[Vec<usize>]) -> usize {
     let mut seen = vec![false; neighbours.len()];
@@ -634,6 +645,7 @@ mod tests {
         let asm = build(&[("3005", 0, 0, 0, R0), ("3005", 1, 0, 0, R0)]);
         let report = verify(&asm, None);
         assert_eq!(report.failures, [Failure::Disconnected { components: 2 }]);
+        assert_eq!(components(&asm), 2);
         assert!(
             report.to_string().contains("falls apart into 2"),
             "{report}"

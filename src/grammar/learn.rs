@@ -588,12 +588,6 @@ impl Learned {
                  no build used (they start, and join only through `unseen`, if any).",
                 r.parts.len()
             );
-        } else {
-            let _ = writeln!(
-                h,
-                "Parts: only the {} the builds used (--seen-parts-only).",
-                r.parts.len()
-            );
         }
         h.push_str(
             "\n\
