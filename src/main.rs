@@ -297,6 +297,22 @@ impl Progress for Spinners {
             b.finish_and_clear();
         }
     }
+    fn advance(&self, done: u64, total: u64) {
+        if let Some(b) = self.bar.borrow().as_ref() {
+            if b.length() != Some(total) {
+                // From a spinner to a bar with counts and time left.
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{spinner} {msg} [{bar:30}] {pos}/{len}, {eta} left",
+                    )
+                    .expect("valid template")
+                    .progress_chars("=> "),
+                );
+                b.set_length(total);
+            }
+            b.set_position(done);
+        }
+    }
 }
 
 /// The longest time budget kept: about 31 years; more is taken as this

@@ -430,6 +430,12 @@ pub trait Progress {
     fn stage(&self, name: &str);
     /// The current stage ended.
     fn done(&self);
+    /// `done` of the current stage's `total` items are finished (step
+    /// images drawn, say), for a display with counts and time left. By
+    /// default nothing.
+    fn advance(&self, done: u64, total: u64) {
+        let _ = (done, total);
+    }
 }
 
 /// No progress display.
@@ -656,7 +662,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 size_cm,
                 step_notes: step_notes.clone(),
             };
-            let rendered = pictures::render_all(&pictures, wants_steps)?;
+            let rendered = pictures::render_all(&pictures, wants_steps, progress)?;
             times.render = secs(t);
             let booklet = if formats.contains(Format::Pdf) {
                 let t = Instant::now();

@@ -749,7 +749,11 @@ fn learned_rules_drive_a_build() {
         // the label.
         let rest = line.trim_start()[label.len()..].trim_start();
         match label {
-            "counts" => rest.split_whitespace().take(3).collect::<Vec<_>>().join(" "),
+            "counts" => rest
+                .split_whitespace()
+                .take(3)
+                .collect::<Vec<_>>()
+                .join(" "),
             _ => rest.split_whitespace().next().unwrap().to_string(),
         }
     };

@@ -124,8 +124,20 @@ fn bytes(input: &Input, seeds: &[Vec<u8>], dict: &[&str]) -> Vec<u8> {
 
 /// Numbers that break naive parsers, shared by every dictionary.
 const NUMBERS: &[&str] = &[
-    " 0", " -1", " 1e39", " -1e39", " nan", " inf", " 4294967295", " 18446744073709551616",
-    " 2147483648", " 0.5", " 1e-45", " -0", " 99999999999999999999", " 3",
+    " 0",
+    " -1",
+    " 1e39",
+    " -1e39",
+    " nan",
+    " inf",
+    " 4294967295",
+    " 18446744073709551616",
+    " 2147483648",
+    " 0.5",
+    " 1e-45",
+    " -0",
+    " 99999999999999999999",
+    " 3",
 ];
 
 fn dict(words: &[&'static str]) -> Vec<&'static str> {
@@ -135,8 +147,18 @@ fn dict(words: &[&'static str]) -> Vec<&'static str> {
 fn cube() -> ([[f32; 3]; 8], [[u32; 3]; 12]) {
     let v = std::array::from_fn(|i| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32]);
     let t = [
-        [0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-        [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5],
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
     ];
     (v, t)
 }
@@ -222,7 +244,10 @@ fn base64(bytes: &[u8]) -> String {
 }
 
 fn gltf_seeds() -> Vec<Vec<u8>> {
-    let data = format!("data:application/octet-stream;base64,{}", base64(&cube_buffer()));
+    let data = format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&cube_buffer())
+    );
     vec![
         gltf_json(Some(&data)).into_bytes(),
         gltf_json(Some("cube.bin")).into_bytes(),

@@ -434,6 +434,26 @@ fn warnings_go_to_stderr_and_survive_quiet() {
     let err = text(&o.stderr);
     assert!(err.lines().count() >= 1, "{err}");
     assert!(err.lines().all(|l| l.starts_with("warning: ")), "{err}");
+    // Without --quiet, with images drawn: the same warnings, and no
+    // progress display on a standard error that is not a terminal.
+    let o = brickwright(
+        tmp.path(),
+        &[
+            "build",
+            &fixture("house.obj"),
+            "-o",
+            "o2",
+            "--studs",
+            "8",
+            "--formats",
+            "ldr,steps",
+            "--stability-budget",
+            "0.000001",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", describe(&o));
+    assert!(text(&o.stdout).contains("step images"), "{}", describe(&o));
+    assert_eq!(text(&o.stderr), err, "{}", describe(&o));
 }
 
 #[test]

@@ -48,12 +48,31 @@ fn options() -> RenderOptions {
     RenderOptions::default()
 }
 
-/// Renders what the outputs need: step images only when `steps`.
-pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError> {
+/// Renders what the outputs need: step images only when `steps`, their
+/// count reported to `progress` as they are drawn.
+pub fn render_all(
+    p: &Pictures<'_>,
+    steps: bool,
+    progress: &dyn super::Progress,
+) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
     let step_images = if steps {
-        step_images(&renderer)
+        let total = p.assembly.step_count() as u64;
+        // The images are drawn on worker threads; each finished one is
+        // counted here, on the caller's thread.
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        std::thread::scope(|s| {
+            let worker = s.spawn(|| step_images(&renderer, tx));
+            let mut done = 0;
+            for () in rx {
+                done += 1;
+                progress.advance(done, total);
+            }
+            worker
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e))
+        })
     } else {
         Vec::new()
     };
@@ -66,15 +85,19 @@ pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError
     })
 }
 
-/// Every step image, drawn incrementally in as many runs as threads.
-fn step_images(renderer: &StepRenderer) -> Vec<RgbaImage> {
+/// Every step image, drawn incrementally in as many runs as threads; a
+/// message on `drawn` for each.
+fn step_images(renderer: &StepRenderer, drawn: std::sync::mpsc::Sender<()>) -> Vec<RgbaImage> {
     renderer
         .runs()
         .into_par_iter()
         .map(|r| {
             renderer
                 .images_in(r)
-                .map(|(_, img)| img)
+                .map(|(_, img)| {
+                    let _ = drawn.send(());
+                    img
+                })
                 .collect::<Vec<_>>()
         })
         .collect::<Vec<_>>()
