@@ -9,10 +9,11 @@
 //! file (`fuzz.proptest-regressions`) so the next run tries it first.
 //!
 //! `cargo test` runs a short round: 2,000 inputs a parser. The long run,
-//! a million inputs each:
+//! a million inputs each, in the test profile (optimized, with overflow
+//! checks, which turn silent wrap-arounds into findings):
 //!
 //! ```sh
-//! BRICKWRIGHT_FUZZ_CASES=1000000 cargo test --release --test fuzz
+//! BRICKWRIGHT_FUZZ_CASES=1000000 cargo test --test fuzz
 //! ```
 
 use std::path::{Path, PathBuf};

@@ -343,10 +343,10 @@ fn rule_files_that_cannot_cover_the_shape_say_what_they_lack() {
 
     // A model of 2x2 and 2x4 bricks only: its learned file builds any
     // shape, as the built-in parts stay in...
-    let wall = "1 4 20 -24 10 1 0 0 0 1 0 0 0 1 3003.dat\n\
-                1 4 60 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n0 STEP\n\
+    let wall = "1 4 20 -24 20 1 0 0 0 1 0 0 0 1 3003.dat\n\
+                1 4 80 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n0 STEP\n\
                 1 4 40 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n\
-                1 4 80 -48 10 1 0 0 0 1 0 0 0 1 3003.dat\n";
+                1 4 100 -48 20 1 0 0 0 1 0 0 0 1 3003.dat\n";
     std::fs::write(tmp.path().join("wall.ldr"), wall).unwrap();
     let o = brickwright(
         tmp.path(),

@@ -34,6 +34,26 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     };
     let invalid =
         |e: ::gltf::Error| malformed(format!("not a valid glTF 2.0 file ({e}); re-export it"));
+    // gltf 1.4 subtracts the 12-byte header from a GLB's declared length
+    // unchecked (an overflow panic with overflow checks on): check it here.
+    if let Some(head) = bytes.strip_prefix(b"glTF") {
+        let declared = head
+            .get(4..8)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        match declared {
+            Some(n) if n >= 12 => {}
+            Some(n) => {
+                return Err(malformed(format!(
+                    "the GLB header declares a length of {n} bytes, less than the header itself; re-export it"
+                )))
+            }
+            None => {
+                return Err(malformed(
+                    "too short for a GLB file (no whole header); re-export it".into(),
+                ))
+            }
+        }
+    }
     let ::gltf::Gltf { document, blob } =
         ::gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
     // gltf-json 1.4's validator indexes the accessor list with each
@@ -403,6 +423,20 @@ mod tests {
             let f = write("flip.glb", &b);
             let _ = load(&f.path);
         }
+    }
+
+    #[test]
+    fn a_glb_declaring_less_than_its_header_is_an_error() {
+        // Found by tests/fuzz.rs: a declared length under 12 bytes.
+        let mut b = glb(&cube_json(None), &cube_buffer());
+        for n in [0u32, 11] {
+            b[8..12].copy_from_slice(&n.to_le_bytes());
+            let f = write("short.glb", &b);
+            let e = load(&f.path).unwrap_err().to_string();
+            assert!(e.contains("declares a length of"), "{e}");
+        }
+        let f = write("stub.glb", b"glTF\x02\x00");
+        assert!(load(&f.path).is_err());
     }
 
     #[test]

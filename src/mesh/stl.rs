@@ -37,6 +37,15 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                  holds {have}; re-export it"
             )));
         }
+        if have > n {
+            // Whole triangles past the count would be silently dropped:
+            // a build of part of the mesh. (Less than one triangle of
+            // trailing bytes is padding some exporters add.)
+            return Err(malformed(format!(
+                "binary STL header says {n} triangles but the file holds {have}; \
+                 re-export it"
+            )));
+        }
     }
     let stl = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
         malformed(format!(
