@@ -459,15 +459,11 @@ fn warnings_go_to_stderr_and_survive_quiet() {
 #[test]
 fn every_subcommand_knows_the_version_and_shows_examples() {
     let tmp = tempfile::tempdir().unwrap();
-    let version = format!("{}", env!("CARGO_PKG_VERSION"));
+    let version = env!("CARGO_PKG_VERSION");
     for sub in ["build", "verify", "rules", "learn"] {
         let o = brickwright(tmp.path(), &[sub, "--version"]);
         assert_eq!(o.status.code(), Some(0), "{sub}: {}", describe(&o));
-        assert!(
-            text(&o.stdout).contains(&version),
-            "{sub}: {}",
-            describe(&o)
-        );
+        assert!(text(&o.stdout).contains(version), "{sub}: {}", describe(&o));
         let o = brickwright(tmp.path(), &[sub, "--help"]);
         assert!(
             text(&o.stdout).contains("Examples:\n  brickwright "),
