@@ -1,9 +1,10 @@
 //! Benchmarks of the independent verifier on hostile input: `n` 2x4 bricks
 //! all at one spot (every one overlaps every other), for n = 7,500 and
 //! 30,000. The time should grow about linearly with n (the overlaps are
-//! named for at most 8 earlier pieces each); 30,000 took 0.15 s on the
-//! development machine, against more than a minute when every overlapping
-//! pair was reported.
+//! named for at most 8 earlier pieces each). For scale: `brickwright
+//! verify` of such a 30,000-line file took 0.46 s in all (release build,
+//! reading and reporting included) when this was written, where reporting
+//! every overlapping pair had taken more than a minute.
 //!
 //! ```text
 //! cargo bench --bench verify
