@@ -39,7 +39,8 @@ fn bench(c: &mut Criterion) {
         };
         group.bench_function(BenchmarkId::new("pieces", n), |b| {
             b.iter(|| {
-                let rendered = render_all(&pictures, true).expect("renders");
+                let rendered =
+                    render_all(&pictures, true, &brickwright::pipeline::Silent).expect("renders");
                 booklet(&pictures, &rendered, &template).expect("lays out")
             })
         });

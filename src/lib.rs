@@ -39,4 +39,5 @@ pub mod physics;
 pub mod pipeline;
 pub mod render;
 pub mod search;
+pub mod terminal;
 pub mod voxel;

@@ -13,6 +13,7 @@ use brickwright::assembly::StepGrouping;
 use brickwright::grammar::learn::learn;
 use brickwright::grammar::{extended_alphabet, rules_text, DEFAULT_ALPHABET};
 use brickwright::pipeline::{self, BuildOptions, Progress, Silent};
+use brickwright::terminal::{escape_controls, escape_lines};
 use brickwright::voxel::{Sizing, Up};
 
 /// `println!` that ends the program quietly when standard output has been
@@ -37,9 +38,31 @@ macro_rules! out {
     }};
 }
 
+/// Examples and exit codes, shown after the options in `--help`.
+const AFTER_HELP: &str = "\
+Examples:
+  brickwright build house.obj -o house                 every output in house/
+  brickwright build tower.glb --studs 32 --slopes --formats ldr,pdf
+  brickwright build part.stl --up z --height 12 --stability check
+  brickwright verify house/house.ldr --stability       re-check a build
+  brickwright learn my-builds/ -o learned.rules        rules from your own builds
+  brickwright build house.obj --rules learned.rules -o house-learned
+
+Exit codes: 0 done; 1 a check failed (verify found problems, or a build
+would not stand under --stability check); 2 an error (bad input or options,
+an output that cannot be written). Warnings go to standard error, with
+--quiet too.";
+
 /// Turn a 3D model into a LEGO build a person can assemble.
 #[derive(Parser)]
-#[command(name = "brickwright", version, about, long_about = None)]
+#[command(
+    name = "brickwright",
+    version,
+    about,
+    long_about = None,
+    propagate_version = true,
+    after_help = AFTER_HELP
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -48,8 +71,18 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Build a mesh (OBJ, glTF .gltf/.glb, STL) into bricks: writes DIR/<name>.ldr and DIR/report.json.
+    #[command(after_help = "Examples:
+  brickwright build house.obj -o house
+  brickwright build tower.glb --studs 32 --slopes --formats ldr,pdf,bricklink
+  brickwright build part.stl --up z --height 12 --plates --seed 7
+  brickwright build house.obj --stability check --formats ldr   (exit 1 if a step would fall)")]
     Build(BuildArgs),
     /// Check an LDraw file made of catalog parts: overlaps, connections, placeability, one piece.
+    #[command(after_help = "Examples:
+  brickwright verify house/house.ldr
+  brickwright verify model.mpd --stability --ground baseplate
+
+Exit 0 when sound (and standing, with --stability), 1 when not, 2 on an unreadable file.")]
     Verify {
         /// The .ldr or .mpd file.
         file: PathBuf,
@@ -62,6 +95,9 @@ enum Command {
         ground: GroundArg,
     },
     /// Write a generated rule file (the default rules, or every brick of the catalog).
+    #[command(after_help = "Examples:
+  brickwright rules > default.rules
+  brickwright rules --alphabet extended -o extended.rules")]
     Rules {
         /// Which alphabet: the default seven bricks, or every brick in the catalog.
         #[arg(long, value_enum, default_value_t = Alphabet::Default)]
@@ -71,6 +107,9 @@ enum Command {
         output: Option<PathBuf>,
     },
     /// Learn rule weights from step-ordered LDraw builds (.ldr/.mpd) and write a rule file.
+    #[command(after_help = "Examples:
+  brickwright learn my-builds/ -o learned.rules
+  brickwright learn castle.mpd --seen-parts-only --unseen 0 -o strict.rules")]
     Learn(LearnArgs),
 }
 
@@ -86,6 +125,10 @@ struct LearnArgs {
     /// search can only use joints seen in the builds).
     #[arg(long, default_value_t = brickwright::grammar::learn::DEFAULT_UNSEEN)]
     unseen: f64,
+    /// Keep only the parts the builds used; by default the built-in parts stay in too, so
+    /// the rule file can build any shape (with the parts no build used weighted `unseen`).
+    #[arg(long)]
+    seen_parts_only: bool,
     /// Print nothing but errors (and the rule file, to standard output).
     #[arg(short, long)]
     quiet: bool,
@@ -238,30 +281,6 @@ struct BuildArgs {
     quiet: bool,
 }
 
-/// Says on standard error, even with `--quiet`, what the build left out
-/// and where, and when the search ran out of time.
-fn warn_left_out(r: &pipeline::BuildReport) {
-    let rep = &r.repairs;
-    if rep.budget_left_out > 0 {
-        eprintln!(
-            "warning: {}: the search ran out of time (--time-budget {}); {} voxels above the last layer laid are not built (raise --time-budget or lower --studs)",
-            r.input, r.options.time_budget, rep.budget_left_out
-        );
-    }
-    if rep.left_out > 0 {
-        eprintln!(
-            "warning: {}: {} voxels of the model are left out: nothing could join them to the build",
-            r.input, rep.left_out
-        );
-        for p in &rep.left_out_places {
-            eprintln!(
-                "  {} voxels at layer {}, stud ({}, {}): {}",
-                p.voxels, p.layer, p.x, p.y, p.reason
-            );
-        }
-    }
-}
-
 /// Spinners on standard error, one per stage; hidden when not a terminal.
 struct Spinners {
     bar: std::cell::RefCell<Option<ProgressBar>>,
@@ -282,12 +301,39 @@ impl Progress for Spinners {
             b.finish_and_clear();
         }
     }
+    fn advance(&self, done: u64, total: u64) {
+        if let Some(b) = self.bar.borrow().as_ref() {
+            if b.length() != Some(total) {
+                // From a spinner to a bar with counts and time left.
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{spinner} {msg} [{bar:30}] {pos}/{len}, {eta} left",
+                    )
+                    .expect("valid template")
+                    .progress_chars("=> "),
+                );
+                b.set_length(total);
+            }
+            b.set_position(done);
+        }
+    }
+}
+
+/// The longest time budget kept: about 31 years; more is taken as this
+/// (no budget, in effect) rather than overflowing a clock.
+const MAX_BUDGET_SECS: f64 = 1e9;
+
+/// A `--...-budget` value: positive seconds, saturated at [`MAX_BUDGET_SECS`].
+fn budget(option: &str, secs: f64) -> Result<Duration> {
+    if !(secs.is_finite() && secs > 0.0) {
+        anyhow::bail!("{option} must be a positive number of seconds, not {secs}");
+    }
+    Ok(Duration::from_secs_f64(secs.min(MAX_BUDGET_SECS)))
 }
 
 fn run_build(a: BuildArgs) -> Result<()> {
-    if !(a.time_budget.is_finite() && a.time_budget > 0.0) {
-        anyhow::bail!("--time-budget must be a positive number of seconds");
-    }
+    let time_budget = budget("--time-budget", a.time_budget)?;
+    let stability_budget = budget("--stability-budget", a.stability_budget)?;
     let mut opts = BuildOptions::new(&a.input);
     opts.out_dir = a.output;
     opts.sizing = match (a.studs, a.height) {
@@ -316,10 +362,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     });
     opts.formats = a.formats;
     opts.template = a.template;
-    if !(a.stability_budget.is_finite() && a.stability_budget > 0.0) {
-        anyhow::bail!("--stability-budget must be a positive number of seconds");
-    }
-    opts.stability_budget = Duration::from_secs_f64(a.stability_budget);
+    opts.stability_budget = stability_budget;
     opts.supports = !a.no_supports;
     opts.strict = a.strict;
     opts.stability = match a.stability {
@@ -330,7 +373,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     opts.search = opts
         .search
         .with_seed(a.seed)
-        .with_time_budget(Duration::from_secs_f64(a.time_budget))
+        .with_time_budget(time_budget)
         .with_complex_every(a.complex_every);
     let spinners = Spinners {
         bar: Default::default(),
@@ -338,7 +381,10 @@ fn run_build(a: BuildArgs) -> Result<()> {
     let progress: &dyn Progress = if a.quiet { &Silent } else { &spinners };
     let opts_out = opts.out_dir.clone();
     let out = pipeline::build(&opts, progress)?;
-    warn_left_out(&out.report);
+    // Warnings go to standard error, with --quiet too.
+    for w in build_warnings(&out.report) {
+        eprintln!("warning: {}", escape_controls(&w));
+    }
     if !a.quiet {
         let r = &out.report;
         outln!(
@@ -366,12 +412,6 @@ fn run_build(a: BuildArgs) -> Result<()> {
                 p.color_name,
                 p.bricklink,
                 bl_color
-            );
-        }
-        if !r.unmapped_colors.is_empty() {
-            outln!(
-                "  warning: colours with no known BrickLink or Rebrickable id: {:?}; their parts-list lines say so",
-                r.unmapped_colors
             );
         }
         let is_step = |f: &str| {
@@ -424,15 +464,58 @@ fn run_build(a: BuildArgs) -> Result<()> {
     Ok(())
 }
 
+/// What a user of a finished build should know: each a line for standard
+/// error.
+fn build_warnings(r: &pipeline::BuildReport) -> Vec<String> {
+    let mut out = Vec::new();
+    if !r.unmapped_colors.is_empty() {
+        out.push(format!(
+            "colours with no known BrickLink or Rebrickable id: {:?}; their parts-list lines say so",
+            r.unmapped_colors
+        ));
+    }
+    if r.repairs.budget_left_out > 0 {
+        out.push(format!(
+            "{}: the search ran out of time (--time-budget {}); {} voxels above the last layer laid are not built (raise --time-budget or lower --studs)",
+            r.input, r.options.time_budget, r.repairs.budget_left_out
+        ));
+    }
+    if r.repairs.left_out > 0 {
+        let mut w = format!(
+            "{}: {} voxels of the model are left out: nothing could join them to the build",
+            r.input, r.repairs.left_out
+        );
+        for p in &r.repairs.left_out_places {
+            w.push_str(&format!(
+                "\n  {} voxels at layer {}, stud ({}, {}): {}",
+                p.voxels, p.layer, p.x, p.y, p.reason
+            ));
+        }
+        out.push(w);
+    }
+    if let Some(st) = &r.stability {
+        if st.first_failure.is_none() && !st.complete {
+            out.push(format!(
+                "the stability check covered {} steps before its time budget ran out (raise --stability-budget)",
+                st.steps_checked
+            ));
+        }
+        if let Some(reason) = &st.failure {
+            out.push(reason.clone());
+        }
+    }
+    out
+}
+
 /// The stability lines of the build summary.
 fn print_build_stability(st: &pipeline::StabilityReport) {
     let verdict = match (st.first_failure, st.complete) {
         (None, true) => "stands at every step".to_string(),
         (None, false) => format!(
-            "warning: checked {} steps before its time budget ran out (raise --stability-budget); they and the finished model stand",
+            "checked {} steps before its time budget ran out; they and the finished model stand",
             st.steps_checked
         ),
-        (Some(step), _) => format!("warning: does not stand from step {step} on"),
+        (Some(step), _) => format!("does not stand from step {step} on"),
     };
     outln!(
         "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} analyses)",
@@ -440,9 +523,6 @@ fn print_build_stability(st: &pipeline::StabilityReport) {
     );
     for line in &st.repairs {
         outln!("  repaired {line}");
-    }
-    if let Some(reason) = &st.failure {
-        outln!("  warning: {reason}");
     }
     match st.stands_on_baseplate {
         Some(true) => outln!(
@@ -583,7 +663,11 @@ fn run_learn(a: LearnArgs) -> Result<()> {
     if !(a.unseen.is_finite() && a.unseen >= 0.0) {
         anyhow::bail!("--unseen must be a weight of 0 or more");
     }
-    let learned = learn(&a.builds)?.with_unseen((a.unseen > 0.0).then_some(a.unseen));
+    let mut learned = learn(&a.builds)?;
+    if a.seen_parts_only {
+        learned = learned.seen_parts_only()?;
+    }
+    let learned = learned.with_unseen((a.unseen > 0.0).then_some(a.unseen));
     let text = learned.to_rules_text();
     let file = a.output.filter(|p| p.as_os_str() != "-");
     match &file {
@@ -594,8 +678,12 @@ fn run_learn(a: LearnArgs) -> Result<()> {
     if !a.quiet {
         // The summary goes beside the rule file, never into it.
         match &file {
-            Some(p) => outln!("{}  wrote {}", learned.summary(), p.display()),
-            None => eprint!("{}", learned.summary()),
+            Some(p) => outln!(
+                "{}  wrote {}",
+                escape_lines(&learned.summary()),
+                p.display()
+            ),
+            None => eprint!("{}", escape_lines(&learned.summary())),
         }
     }
     Ok(())
@@ -617,6 +705,12 @@ fn main() -> ExitCode {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
+            // A failed stability check is a finding, as in `verify
+            // --stability`: exit 1; anything else is an error: exit 2.
+            let code = match e.downcast_ref::<pipeline::BuildError>() {
+                Some(pipeline::BuildError::Unstable { .. }) => 1,
+                _ => 2,
+            };
             // One line: the error, then any cause its message does not
             // already say.
             let mut line = e.to_string();
@@ -627,8 +721,8 @@ fn main() -> ExitCode {
                     line.push_str(&c);
                 }
             }
-            eprintln!("error: {line}");
-            ExitCode::from(2)
+            eprintln!("error: {}", escape_controls(&line));
+            ExitCode::from(code)
         }
     }
 }

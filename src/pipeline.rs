@@ -523,6 +523,12 @@ pub trait Progress {
     fn stage(&self, name: &str);
     /// The current stage ended.
     fn done(&self);
+    /// `done` of the current stage's `total` items are finished (step
+    /// images drawn, say), for a display with counts and time left. By
+    /// default nothing.
+    fn advance(&self, done: u64, total: u64) {
+        let _ = (done, total);
+    }
 }
 
 /// No progress display.
@@ -552,6 +558,42 @@ pub fn load_rules(path: Option<&Path>) -> Result<RuleSet, RuleError> {
         Some(p) => RuleSet::load(p),
         None => Ok(default_rules()),
     }
+}
+
+/// The error for a rule file (not the built-in rules) with [`RuleSet::gaps`]
+/// whose build of the input left `left_out` voxels unjoined (`None`: no
+/// build was found); `None` when the rules lack nothing.
+fn cover_error(
+    rules: &RuleSet,
+    opts: &BuildOptions,
+    left_out: Option<usize>,
+) -> Option<BuildError> {
+    let path = opts.rules.as_ref()?;
+    let family = if opts.plates {
+        Family::Plate
+    } else {
+        Family::Brick
+    };
+    let gaps = rules.gaps(family);
+    if gaps.is_empty() {
+        return None;
+    }
+    let input = opts.input.file_name().map_or_else(
+        || opts.input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let what = match left_out {
+        Some(n) => format!("{n} voxels of {input} could not be joined"),
+        None => format!("no build of {input} was found"),
+    };
+    Some(BuildError::Rules(RuleError::File {
+        file: path.display().to_string(),
+        message: format!(
+            "the rules cannot cover the shape ({what}); they lack {}; add those, learn \
+             without --seen-parts-only (the built-in parts stay in), or use the default rules",
+            gaps.join(", and ")
+        ),
+    }))
 }
 
 /// Runs the pipeline and writes `<stem>.ldr` and `report.json` into
@@ -642,7 +684,18 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         verify_secs.set(verify_secs.get() + secs(t));
         Ok((outcome, assembly, order_name))
     };
-    let first = plan(opts.search.seed)?;
+    // A rule file that cannot cover the shape is an error naming what it
+    // lacks, not a build of a fragment.
+    let first = plan(opts.search.seed).map_err(|e| match e {
+        BuildError::Search { .. } => cover_error(&rules, opts, None).unwrap_or(e),
+        e => e,
+    })?;
+    let left_out = first.0.repairs.left_out;
+    if left_out > 0 {
+        if let Some(e) = cover_error(&rules, opts, Some(left_out)) {
+            return Err(e);
+        }
+    }
     if opts.strict {
         let rep = &first.0.repairs;
         if let Some(p) = rep.left_out_places.first() {
@@ -721,7 +774,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 size_cm,
                 step_notes: step_notes.clone(),
             };
-            let rendered = pictures::render_all(&pictures, wants_steps)?;
+            let rendered = pictures::render_all(&pictures, wants_steps, progress)?;
             times.render = secs(t);
             let booklet = if formats.contains(Format::Pdf) {
                 let t = Instant::now();
@@ -748,10 +801,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     progress.stage("writing");
     let t = Instant::now();
-    std::fs::create_dir_all(&opts.out_dir).map_err(|reason| BuildError::Write {
-        path: opts.out_dir.display().to_string(),
-        reason,
-    })?;
+    // Folders made for this run go again if it fails.
+    let mut made = crate::fsutil::CreatedDirs::new();
+    made.create(&opts.out_dir)
+        .map_err(|reason| BuildError::Write {
+            path: opts.out_dir.display().to_string(),
+            reason,
+        })?;
     let report_path = opts.out_dir.join("report.json");
     let meta = LdrMeta {
         title: format!("{stem}, built by brickwright"),
@@ -830,7 +886,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         ),
         parts: parts.rows(),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
-        components: 1,
+        components: crate::assembly::verify::components(&assembly),
         steps: assembly.step_count(),
         booklet_pages: formats
             .contains(Format::Pdf)
@@ -881,10 +937,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                 };
                 match format {
                     Format::Steps => {
-                        std::fs::create_dir_all(&path).map_err(|reason| BuildError::Write {
-                            path: path.display().to_string(),
-                            reason,
-                        })?;
+                        // Never a link to a folder outside `-o`.
+                        crate::fsutil::refuse_link(&path)
+                            .and_then(|()| made.create(&path))
+                            .map_err(|reason| BuildError::Write {
+                                path: path.display().to_string(),
+                                reason,
+                            })?;
                         let pngs = pictures::encode_all(&rendered.steps);
                         let paths = pictures::step_paths(&path, pngs.len());
                         let mut written = Ok(());
@@ -935,6 +994,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         path: path.display().to_string(),
         reason,
     })?;
+    made.keep();
     if let Some((rendered, _)) = &rendered {
         if formats.contains(Format::Steps) {
             pictures::remove_stale_steps(&opts.out_dir.join("steps"), rendered.steps.len());

@@ -726,15 +726,53 @@ fn learned_rules_drive_a_build() {
         "read 2 builds (1 separately built submodel)",
         "1 x 87079",
         "post.mpd:7",
-        "distinct rules",
-        "2,484",
-        "1 to 139",
         "wrote ",
     ] {
         assert!(run.stdout.contains(want), "{want:?}\n{}", run.describe());
     }
     assert_eq!(run.stderr, "", "{}", run.describe());
     let text = std::fs::read_to_string(&rules).unwrap();
+    // The summary's learned column says what the file holds: its rule
+    // lines, the sum of their weights, the lowest and highest weight.
+    let weights: Vec<u64> = text
+        .lines()
+        .filter(|l| l.starts_with("rule "))
+        .map(|l| l.split_whitespace().last().unwrap().parse().unwrap())
+        .collect();
+    assert!(weights.len() > 5, "{text}");
+    let learned = |label: &str| -> String {
+        let line = run
+            .stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(label))
+            .unwrap_or_else(|| panic!("no {label:?} line\n{}", run.describe()));
+        // "label   LEARNED   PAPER": the learned column is the first after
+        // the label.
+        let rest = line.trim_start()[label.len()..].trim_start();
+        match label {
+            "counts" => rest
+                .split_whitespace()
+                .take(3)
+                .collect::<Vec<_>>()
+                .join(" "),
+            _ => rest.split_whitespace().next().unwrap().to_string(),
+        }
+    };
+    let thousands = |n: u64| {
+        let d = n.to_string();
+        let mut out = String::new();
+        for (i, c) in d.chars().enumerate() {
+            if i > 0 && (d.len() - i).is_multiple_of(3) {
+                out.push(',');
+            }
+            out.push(c);
+        }
+        out
+    };
+    assert_eq!(learned("distinct rules"), weights.len().to_string());
+    assert_eq!(learned("total count"), thousands(weights.iter().sum()));
+    let (lo, hi) = (weights.iter().min().unwrap(), weights.iter().max().unwrap());
+    assert_eq!(learned("counts"), format!("{lo} to {hi}"));
     assert!(
         text.contains("\n#   house.ldr, post.mpd\n"),
         "the header names the builds:\n{text}"

@@ -7,6 +7,8 @@
 //! the test says so and passes, except when `CI=true`, where it fails.
 //! `BLESS=1 cargo test --test exports` rewrites the golden files.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -194,11 +196,7 @@ fn xmllint() -> Option<PathBuf> {
     if found {
         return Some(PathBuf::from("xmllint"));
     }
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "xmllint is missing, and CI=true: .ci/run installs libxml2-utils"
-    );
-    eprintln!("skipped: xmllint is missing (apt-get install libxml2-utils)");
+    common::missing_tool("xmllint", "apt-get install libxml2-utils");
     None
 }
 
@@ -240,18 +238,7 @@ fn the_wanted_list_validates_against_the_schema() {
 }
 
 fn golden(name: &str, got: &str) {
-    let path = root().join("tests/golden").join(name);
-    if std::env::var_os("BLESS").is_some() {
-        std::fs::write(&path, got).unwrap();
-    }
-    let want = std::fs::read_to_string(&path)
-        .unwrap_or_else(|_| panic!("{} is missing; BLESS=1 creates it", path.display()));
-    assert_eq!(
-        got,
-        want,
-        "{} differs from the output; BLESS=1 to accept",
-        path.display()
-    );
+    common::golden_text(&root().join("tests/golden").join(name), got);
 }
 
 #[test]

@@ -3,6 +3,8 @@
 //! Run `BLESS=1 cargo test --test ldraw_roundtrip` to rewrite the golden
 //! file after an intended change to the output, then review the diff.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use brickwright::assembly::{Assembly, Placed, Placement, Step};
@@ -154,16 +156,7 @@ fn golden_small_ldr() {
     };
     write_ldr(&mut out, &golden_assembly(), &meta).unwrap();
     let text = String::from_utf8(out).unwrap();
-    if std::env::var_os("BLESS").is_some() {
-        std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
-        std::fs::write(&golden, &text).unwrap();
-    }
-    let want = std::fs::read_to_string(&golden)
-        .expect("tests/golden/small.ldr is missing; run with BLESS=1 to create it");
-    assert_eq!(
-        text, want,
-        "output differs from the golden file; BLESS=1 to accept"
-    );
+    common::golden_text(&golden, &text);
     // The golden file reads back to the same assembly.
     let back = to_assembly(&read_ldr(&golden).unwrap()).unwrap();
     assert_eq!(back, golden_assembly());
@@ -352,7 +345,7 @@ fn garbage_and_truncated_input_never_panics() {
         let mut out = String::new();
         for line in &lines {
             let mut toks: Vec<&str> = line.split(' ').collect();
-            if rng.next() % 3 == 0 {
+            if rng.next().is_multiple_of(3) {
                 let k = (rng.next() as usize) % toks.len();
                 toks[k] = nasty[(rng.next() as usize) % nasty.len()];
             }

@@ -89,7 +89,9 @@ fn check_refuses_a_build_that_tips_over_with_one_line_and_no_files() {
     let tmp = tempfile::tempdir().unwrap();
     let (run, out) = build_gallows(tmp.path(), &["--stability", "check"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    // A failed check is a finding, not an error: exit 1, as `verify
+    // --stability` does.
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(
         stderr.starts_with("error: ") && stderr.contains("gallows.obj: at step "),
@@ -192,7 +194,8 @@ fn repair_without_supports_reports_what_it_could_not_fix_and_draws_the_stress() 
     let (run, out) = build_gallows(tmp.path(), &["--formats", "ldr,stress", "--no-supports"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
-    assert!(stdout.contains("warning: at step"), "{stdout}");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("warning: at step"), "{stderr}");
     assert!(stdout.contains("baseplate"), "{stdout}");
     let r = report(&out);
     let st = &r["stability"];
@@ -278,7 +281,12 @@ fn the_check_stops_at_its_time_budget_and_says_so() {
     );
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
-    assert!(stdout.contains("--stability-budget"), "{stdout}");
+    // The warning is on standard error.
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("warning: ") && stderr.contains("--stability-budget"),
+        "{stderr}"
+    );
     let r = report(&out);
     let st = &r["stability"];
     assert_eq!(st["complete"], false, "{st}");

@@ -9,7 +9,6 @@
 //! Chromium is required: without it the test fails, unless
 //! `BRICKWRIGHT_SKIP_TOOLS=1` asks to skip (`.ci/run` installs it).
 
-#[allow(dead_code, reason = "each test crate uses the helpers it needs")]
 mod common;
 
 use std::path::{Path, PathBuf};

@@ -70,7 +70,7 @@ use crate::assembly::Placement;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Failure {
     /// Pieces `a < b` share `cell` (the first shared cell of `b`'s box,
-    /// reported once per pair).
+    /// reported once per pair, for at most 8 earlier pieces `a` a piece).
     Overlap {
         /// The earlier piece.
         a: usize,
@@ -144,7 +144,11 @@ impl fmt::Display for Failure {
     }
 }
 
+/// How many failures a [`VerifyReport`] shows; the rest are counted.
+pub const SHOWN_FAILURES: usize = 20;
+
 /// Everything [`verify`] found wrong; empty when the assembly is sound.
+/// It displays the first [`SHOWN_FAILURES`] and a count of the rest.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct VerifyReport {
     /// The failures: overlaps first, then per piece in build order, then the
@@ -165,8 +169,15 @@ impl fmt::Display for VerifyReport {
             return write!(f, "assembly verified: no failures");
         }
         write!(f, "{} verification failure(s):", self.failures.len())?;
-        for failure in &self.failures {
+        for failure in self.failures.iter().take(SHOWN_FAILURES) {
             write!(f, "\n  - {failure}")?;
+        }
+        if self.failures.len() > SHOWN_FAILURES {
+            write!(
+                f,
+                "\n  ... and {} more",
+                self.failures.len() - SHOWN_FAILURES
+            )?;
         }
         Ok(())
     }
@@ -220,21 +231,32 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
     VerifyReport { failures }
 }
 
-/// Every pair of pieces sharing a cell, with the first shared cell of the
-/// later piece.
+/// At most this many earlier pieces are named for one overlapping piece,
+/// and this many owners are remembered for one cell: a sound or nearly
+/// sound build never comes close, and a file stacking thousands of pieces
+/// on one spot is checked in linear time instead of pair by pair.
+const MAX_OVERLAPS_PER_PIECE: usize = 8;
+
+/// Pairs of pieces sharing a cell, with the first shared cell of the later
+/// piece; for each later piece, at most [`MAX_OVERLAPS_PER_PIECE`] earlier
+/// ones.
 fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
     let mut owners: HashMap<Cell, Vec<usize>> = HashMap::new();
-    let mut reported: HashSet<(usize, usize)> = HashSet::new();
     let mut failures = Vec::new();
+    let mut named: Vec<usize> = Vec::new();
     for (b, bx) in boxes.iter().enumerate() {
+        named.clear();
         for cell in bx.cells() {
             let here = owners.entry(cell).or_default();
             for &a in here.iter() {
-                if reported.insert((a, b)) {
+                if named.len() < MAX_OVERLAPS_PER_PIECE && !named.contains(&a) {
+                    named.push(a);
                     failures.push(Failure::Overlap { a, b, cell });
                 }
             }
-            here.push(b);
+            if here.len() < MAX_OVERLAPS_PER_PIECE {
+                here.push(b);
+            }
         }
     }
     failures
@@ -245,19 +267,39 @@ fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
 /// that can touch face to face, whether or not studs meet. Sorted by
 /// `below`, then `above`. [`connections`] keeps those where studs meet
 /// tubes; the physics stage also uses the others (compression only).
+///
+/// Found through the cells under each piece, so the time grows with the
+/// pieces' footprints, not with the square of the pieces in a layer.
 pub fn stacked_pairs(bodies: &[Body]) -> Vec<(usize, usize)> {
-    let mut by_bottom: HashMap<i32, Vec<usize>> = HashMap::new();
+    // The pieces whose bounding box's bottom layer covers each cell.
+    let mut bottoms: HashMap<Cell, Vec<usize>> = HashMap::new();
     for (i, b) in bodies.iter().enumerate() {
-        by_bottom.entry(b.bbox.min.z).or_default().push(i);
-    }
-    let mut pairs = Vec::new();
-    for (below, a) in bodies.iter().enumerate() {
-        let top = a.bbox.max_excl().z;
-        for &above in by_bottom.get(&top).into_iter().flatten() {
-            if a.bbox.footprints_overlap(&bodies[above].bbox) {
-                pairs.push((below, above));
+        let bx = &b.bbox;
+        for y in bx.min.y..bx.min.y + bx.sy {
+            for x in bx.min.x..bx.min.x + bx.sx {
+                bottoms
+                    .entry(Cell::new(x, y, bx.min.z))
+                    .or_default()
+                    .push(i);
             }
         }
+    }
+    let mut pairs = Vec::new();
+    let mut above: Vec<usize> = Vec::new();
+    for (below, a) in bodies.iter().enumerate() {
+        let bx = &a.bbox;
+        let top = bx.max_excl().z;
+        above.clear();
+        for y in bx.min.y..bx.min.y + bx.sy {
+            for x in bx.min.x..bx.min.x + bx.sx {
+                if let Some(on) = bottoms.get(&Cell::new(x, y, top)) {
+                    above.extend(on);
+                }
+            }
+        }
+        above.sort_unstable();
+        above.dedup();
+        pairs.extend(above.iter().map(|&i| (below, i)));
     }
     pairs
 }
@@ -273,6 +315,17 @@ pub fn connections(bodies: &[Body]) -> Vec<Vec<usize>> {
         }
     }
     neighbours
+}
+
+/// Number of stud-connected components of `asm`: 1 for a build that holds
+/// together, 0 for no pieces.
+pub fn components(asm: &Assembly) -> usize {
+    let bodies: Vec<Body> = asm
+        .pieces
+        .iter()
+        .map(|p| p.placement.body(asm.layer_ldu))
+        .collect();
+    count_components(&connections(&bodies))
 }
 
 /// Number of connected components of the graph (0 for no pieces).
@@ -592,10 +645,50 @@ mod tests {
         let asm = build(&[("3005", 0, 0, 0, R0), ("3005", 1, 0, 0, R0)]);
         let report = verify(&asm, None);
         assert_eq!(report.failures, [Failure::Disconnected { components: 2 }]);
+        assert_eq!(components(&asm), 2);
         assert!(
             report.to_string().contains("falls apart into 2"),
             "{report}"
         );
+    }
+
+    #[test]
+    fn thousands_of_pieces_on_one_spot_give_a_bounded_report() {
+        // 30,000 2x4s at the same place: every one after the first overlaps
+        // all earlier ones. Each is named with at most 8 of them, and the
+        // display shows the first few and counts the rest.
+        let pieces = vec![("3001", 0, 0, 0, R0); 30_000];
+        let report = verify(&build(&pieces), None);
+        let overlaps = report
+            .failures
+            .iter()
+            .filter(|f| matches!(f, Failure::Overlap { .. }))
+            .count();
+        assert_eq!(overlaps, 28 + 8 * (30_000 - 8));
+        assert!(report
+            .failures
+            .iter()
+            .all(|f| matches!(f, Failure::Overlap { .. } | Failure::Disconnected { .. })));
+        let text = report.to_string();
+        assert_eq!(text.lines().count(), 1 + SHOWN_FAILURES + 1, "{text}");
+        assert!(text.ends_with(&format!(
+            "... and {} more",
+            report.failures.len() - SHOWN_FAILURES
+        )));
+    }
+
+    #[test]
+    fn stacked_pairs_are_the_face_to_face_pairs_sorted() {
+        // A 2x4 on two 2x2s side by side, and a 1x1 beside the stack.
+        let asm = build(&[
+            ("3003", 0, 0, 0, R0),
+            ("3003", 2, 0, 0, R0),
+            ("3005", 6, 0, 0, R0),
+            ("3001", 0, 0, 1, R0),
+            ("3005", 3, 1, 2, R0),
+        ]);
+        let bodies: Vec<Body> = asm.pieces.iter().map(|p| p.placement.body(24)).collect();
+        assert_eq!(stacked_pairs(&bodies), [(0, 3), (1, 3), (3, 4)]);
     }
 
     #[test]

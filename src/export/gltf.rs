@@ -563,7 +563,7 @@ struct BinBuilder {
 impl BinBuilder {
     /// Appends `bytes` as a new buffer view, 4-byte aligned.
     fn view(&mut self, bytes: impl IntoIterator<Item = u8>, target: Option<u32>) -> u32 {
-        while self.data.len() % 4 != 0 {
+        while !self.data.len().is_multiple_of(4) {
             self.data.push(0);
         }
         let start = self.data.len();

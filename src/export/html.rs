@@ -573,7 +573,7 @@ mod tests {
         for part in PartKind::all() {
             let mesh = part_mesh(part);
             let bare = bare_triangles(mesh);
-            assert!(bare.len() % 3 == 0 && !bare.is_empty(), "{part}");
+            assert!(bare.len().is_multiple_of(3) && !bare.is_empty(), "{part}");
             assert!(
                 bare.len() * 2 < mesh.indices.len(),
                 "{part}: {}",

@@ -63,7 +63,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use thiserror::Error;
 
-use super::{Dir, Rule, RuleError, RuleSet, StartRule};
+use super::{Dir, Rule, RuleError, RuleSet, StartRule, DEFAULT_ALPHABET};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::{Body, Rot};
@@ -336,7 +336,18 @@ impl Learner {
         report
             .skipped
             .sort_by(|a, b| b.count.cmp(&a.count).then_with(|| a.part.cmp(&b.part)));
-        let rules = rule_set(&report.parts, &counts)?;
+        // The built-in alphabet stays in beside the parts seen, so the file
+        // builds any shape (unused parts get the `unseen` weight, if any);
+        // [`Learned::seen_parts_only`] drops it.
+        let mut alphabet = report.parts.clone();
+        alphabet.extend(
+            DEFAULT_ALPHABET
+                .iter()
+                .filter_map(|id| PartKind::from_id(id)),
+        );
+        alphabet.sort_unstable();
+        alphabet.dedup();
+        let rules = rule_set(&alphabet, &counts)?;
         Ok(Learned {
             counts,
             report,
@@ -500,8 +511,21 @@ impl Learned {
         self
     }
 
-    /// The rule set of the counts: every part seen, a starting rule for
-    /// each, the rules with their counts as weights.
+    /// These counts over the parts the builds used only, without the
+    /// built-in alphabet: the search can then use no other part (and a
+    /// shape those parts cannot cover is an error at build time).
+    pub fn seen_parts_only(mut self) -> Result<Learned, LearnError> {
+        let seen = &self.report.parts;
+        self.rules = self
+            .rules
+            .restricted(|p| seen.contains(&p))
+            .map_err(LearnError::Inconsistent)?;
+        Ok(self)
+    }
+
+    /// The rule set of the counts: every part seen and (unless
+    /// [`Learned::seen_parts_only`]) the built-in alphabet, a starting rule
+    /// for each, the rules with their counts as weights.
     pub fn rule_set(&self) -> &RuleSet {
         &self.rules
     }
@@ -556,6 +580,15 @@ impl Learned {
             thousands((r.pieces - r.learned_pieces) as u64)
         );
         let _ = writeln!(h, "{}.", self.totals());
+        let extra = self.rules.alphabet().len().saturating_sub(r.parts.len());
+        if extra > 0 {
+            let _ = writeln!(
+                h,
+                "Parts: the {} the builds used, and {extra} more of the built-in alphabet\n\
+                 no build used (they start, and join only through `unseen`, if any).",
+                r.parts.len()
+            );
+        }
         h.push_str(
             "\n\
              Each weight is a count (the paper's \"example data\", section 3): every\n\
@@ -669,7 +702,7 @@ fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);

@@ -30,6 +30,7 @@
 //! ```
 
 pub mod complex;
+mod cover;
 mod defaults;
 pub mod learn;
 mod parse;

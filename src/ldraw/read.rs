@@ -130,7 +130,7 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
         out: &mut parts,
         instances: &mut instances,
         expanded: 0,
-        stack: vec![file.main],
+        open: (0..file.sections.len()).map(|i| i == file.main).collect(),
     };
     let mut step = 0;
     for cmd in &file.sections[file.main].cmds {
@@ -533,6 +533,10 @@ fn parse_ref(mut rest: &str, path: &Path, line: usize) -> Result<RawRef, LdrErro
 }
 
 /// Pass 2: expands submodel references depth first into part references.
+///
+/// The expansion keeps its own stack of open submodels rather than
+/// recursing, so however deep a file nests its submodels, the program's
+/// stack does not grow with it.
 struct Flattener<'a> {
     file: &'a File,
     path: &'a Path,
@@ -541,11 +545,21 @@ struct Flattener<'a> {
     instances: &'a mut Vec<Instance>,
     /// References expanded so far, against [`MAX_EXPANDED`].
     expanded: usize,
-    /// Sections being expanded, to catch a submodel that contains itself.
-    stack: Vec<usize>,
+    /// Sections being expanded, by section index, to catch a submodel that
+    /// contains itself.
+    open: Vec<bool>,
 }
 
-impl Flattener<'_> {
+/// A submodel being expanded: its remaining commands and its placement.
+struct Frame<'a> {
+    section: usize,
+    cmds: std::slice::Iter<'a, Cmd>,
+    xf: Xform,
+    color: Color,
+    instance: usize,
+}
+
+impl<'a> Flattener<'a> {
     /// Expands `r`, found inside model instance `instance` placed by
     /// `parent` in `color`, at main-model step `step`.
     fn expand(
@@ -556,6 +570,35 @@ impl Flattener<'_> {
         step: usize,
         instance: usize,
     ) -> Result<(), LdrError> {
+        let mut frames: Vec<Frame<'a>> = Vec::new();
+        frames.extend(self.enter(r, parent, color, step, instance)?);
+        while let Some(top) = frames.last_mut() {
+            match top.cmds.next() {
+                Some(Cmd::Ref(child)) => {
+                    let (xf, color, me) = (top.xf, top.color, top.instance);
+                    let inner = self.enter(child, &xf, color, step, me)?;
+                    frames.extend(inner);
+                }
+                Some(Cmd::Step) => {}
+                None => {
+                    self.open[top.section] = false;
+                    frames.pop();
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Places `r`: a part goes to the output; a submodel opens a new
+    /// [`Frame`] for its commands.
+    fn enter(
+        &mut self,
+        r: &RawRef,
+        parent: &Xform,
+        color: Color,
+        step: usize,
+        instance: usize,
+    ) -> Result<Option<Frame<'a>>, LdrError> {
         self.expanded += 1;
         if self.expanded > MAX_EXPANDED {
             return Err(LdrError::TooLarge {
@@ -570,7 +613,8 @@ impl Flattener<'_> {
         } else {
             r.color
         };
-        let Some(&sub) = self.file.by_name.get(&normalize_name(&r.name)) else {
+        let file: &'a File = self.file;
+        let Some(&sub) = file.by_name.get(&normalize_name(&r.name)) else {
             self.out.push(PartRef {
                 step,
                 color,
@@ -580,29 +624,28 @@ impl Flattener<'_> {
                 line: r.line,
                 instance,
             });
-            return Ok(());
+            return Ok(None);
         };
-        if self.stack.contains(&sub) {
+        if self.open[sub] {
             return Err(LdrError::Recursion {
                 path: self.path.to_path_buf(),
                 line: r.line,
                 name: r.name.clone(),
             });
         }
-        self.stack.push(sub);
+        self.open[sub] = true;
         self.instances.push(Instance {
             parent: Some(instance),
             name: r.name.clone(),
             line: r.line,
         });
-        let me = self.instances.len() - 1;
-        for cmd in &self.file.sections[sub].cmds {
-            if let Cmd::Ref(child) = cmd {
-                self.expand(child, &xf, color, step, me)?;
-            }
-        }
-        self.stack.pop();
-        Ok(())
+        Ok(Some(Frame {
+            section: sub,
+            cmds: file.sections[sub].cmds.iter(),
+            xf,
+            color,
+            instance: self.instances.len() - 1,
+        }))
     }
 }
 
@@ -718,6 +761,35 @@ mod tests {
             );
         }
         assert!(matches!(parse(&text), Err(LdrError::TooLarge { .. })));
+    }
+
+    #[test]
+    fn a_100000_deep_chain_of_submodels_is_read_without_recursion() {
+        // m0 holds m1, which holds m2, ... down to a brick: the depth is
+        // set by the file, so the reader must not recurse on it.
+        const DEPTH: usize = 100_000;
+        let mut text = String::new();
+        for i in 0..DEPTH {
+            text += &format!("0 FILE m{i}\n1 16 0 -24 0 1 0 0 0 1 0 0 0 1 m{}\n", i + 1);
+        }
+        text += &format!("0 FILE m{DEPTH}\n1 4 0 -24 0 1 0 0 0 1 0 0 0 1 3001.dat\n");
+        // On a small thread stack, as a recursive reader would overflow it.
+        let m = std::thread::Builder::new()
+            .stack_size(256 * 1024)
+            .spawn(move || parse(&text).unwrap())
+            .unwrap()
+            .join()
+            .unwrap();
+        assert_eq!(m.parts.len(), 1);
+        assert_eq!(m.instances.len(), DEPTH + 1);
+        assert_eq!(m.parts[0].pos[1], -24.0 * (DEPTH + 1) as f64);
+        // A cycle at the bottom of the chain is still found.
+        let mut text = String::new();
+        for i in 0..1000 {
+            text += &format!("0 FILE m{i}\n1 16 0 0 0 1 0 0 0 1 0 0 0 1 m{}\n", i + 1);
+        }
+        text += "0 FILE m1000\n1 16 0 0 0 1 0 0 0 1 0 0 0 1 m500\n";
+        assert!(matches!(parse(&text), Err(LdrError::Recursion { .. })));
     }
 
     #[test]

@@ -25,7 +25,8 @@ use super::{finish, Location, Mesh, MeshError};
 const MAX_TRIANGLES: usize = 50_000_000;
 
 /// Parses the glTF (JSON or binary) data in `bytes`, read from `path`.
-/// Relative buffer URIs are resolved next to `path`.
+/// Relative buffer URIs are resolved inside `path`'s folder only (see
+/// [`super::buffers`]).
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let malformed = |reason: String| MeshError::Malformed {
         at: Location::file(path),
@@ -33,6 +34,26 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     };
     let invalid =
         |e: ::gltf::Error| malformed(format!("not a valid glTF 2.0 file ({e}); re-export it"));
+    // gltf 1.4 subtracts the 12-byte header from a GLB's declared length
+    // unchecked (an overflow panic with overflow checks on): check it here.
+    if let Some(head) = bytes.strip_prefix(b"glTF") {
+        let declared = head
+            .get(4..8)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        match declared {
+            Some(n) if n >= 12 => {}
+            Some(n) => {
+                return Err(malformed(format!(
+                    "the GLB header declares a length of {n} bytes, less than the header itself; re-export it"
+                )))
+            }
+            None => {
+                return Err(malformed(
+                    "too short for a GLB file (no whole header); re-export it".into(),
+                ))
+            }
+        }
+    }
     let ::gltf::Gltf { document, blob } =
         ::gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
     // gltf-json 1.4's validator indexes the accessor list with each
@@ -52,10 +73,13 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         }
     }
     let document = ::gltf::Document::from_json(root).map_err(invalid)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = ::gltf::import_buffers(&document, Some(base), blob)
-        .map_err(|e| malformed(format!("cannot load the glTF buffers ({e})")))?;
-    let buffers: Vec<&[u8]> = buffers.iter().map(|b| &b.0[..]).collect();
+    let base = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let buffers = super::buffers::load(&document, base, blob)
+        .map_err(|e| malformed(format!("cannot load the glTF buffers: {e}")))?;
+    let buffers: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
 
     let mut raw = Mesh::default();
     let scene = document
@@ -300,11 +324,11 @@ mod tests {
 
     fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
         let mut j = json.as_bytes().to_vec();
-        while j.len() % 4 != 0 {
+        while !j.len().is_multiple_of(4) {
             j.push(b' ');
         }
         let mut b = bin.to_vec();
-        while b.len() % 4 != 0 {
+        while !b.len().is_multiple_of(4) {
             b.push(0);
         }
         let total = 12 + 8 + j.len() + 8 + b.len();
@@ -402,6 +426,20 @@ mod tests {
     }
 
     #[test]
+    fn a_glb_declaring_less_than_its_header_is_an_error() {
+        // Found by tests/fuzz.rs: a declared length under 12 bytes.
+        let mut b = glb(&cube_json(None), &cube_buffer());
+        for n in [0u32, 11] {
+            b[8..12].copy_from_slice(&n.to_le_bytes());
+            let f = write("short.glb", &b);
+            let e = load(&f.path).unwrap_err().to_string();
+            assert!(e.contains("declares a length of"), "{e}");
+        }
+        let f = write("stub.glb", b"glTF\x02\x00");
+        assert!(load(&f.path).is_err());
+    }
+
+    #[test]
     fn accessor_past_buffer_end_is_an_error() {
         let json = cube_json(None).replace(r#""count": 8"#, r#""count": 800"#);
         let f = write("long.glb", &glb(&json, &cube_buffer()));
@@ -417,5 +455,93 @@ mod tests {
         let f = write("inf.glb", &glb(&json, &cube_buffer()));
         let e = load(&f.path).unwrap_err();
         assert!(matches!(e, MeshError::NonFinite { .. }), "{e}");
+    }
+
+    /// Loads a `.gltf` in `dir/model/` whose buffer URI is `uri`; `dir`
+    /// also holds `outside.bin`, a valid cube buffer out of the folder.
+    fn load_with_uri(dir: &std::path::Path, uri: &str) -> Result<super::Mesh, MeshError> {
+        let model = dir.join("model");
+        std::fs::create_dir_all(&model).unwrap();
+        std::fs::write(dir.join("outside.bin"), cube_buffer()).unwrap();
+        let path = model.join("m.gltf");
+        std::fs::write(&path, cube_json(Some(uri))).unwrap();
+        load(&path)
+    }
+
+    #[test]
+    fn buffer_uris_stay_in_the_model_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = dir.path().join("outside.bin");
+        for uri in [
+            "file:///etc/passwd".to_string(),
+            "/etc/passwd".to_string(),
+            "../outside.bin".to_string(),
+            format!("file://{}", outside.display()),
+            outside.display().to_string(),
+        ] {
+            let e = load_with_uri(dir.path(), &uri).unwrap_err().to_string();
+            assert!(e.contains("m.gltf") && e.contains("buffer 0"), "{uri}: {e}");
+            // Nothing of the file named leaks into the message.
+            assert!(!e.contains("root:"), "{uri}: {e}");
+        }
+        // The same buffer inside the folder builds.
+        std::fs::write(dir.path().join("model/inside.bin"), cube_buffer()).unwrap();
+        check_transformed_cube(&load_with_uri(dir.path(), "inside.bin").unwrap());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_fifos_and_links_out_are_refused_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model");
+        std::fs::create_dir_all(&model).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", model.join("zero.bin")).unwrap();
+        std::os::unix::fs::symlink(dir.path().join("outside.bin"), model.join("out.bin")).unwrap();
+        let fifo = model.join("fifo.bin");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        for uri in [
+            "/dev/zero",
+            "/dev/urandom",
+            "zero.bin",
+            "out.bin",
+            "fifo.bin",
+        ] {
+            if uri == "fifo.bin" && !made.as_ref().is_ok_and(|s| s.success()) {
+                continue;
+            }
+            // Returns (no hang on the FIFO, no endless read of /dev/zero).
+            let e = load_with_uri(dir.path(), uri).unwrap_err().to_string();
+            assert!(e.contains("buffer 0"), "{uri}: {e}");
+        }
+        // A device inside the folder is not a regular file.
+        std::fs::remove_file(model.join("zero.bin")).unwrap();
+        let e = std::fs::hard_link("/dev/null", model.join("null.bin"));
+        if e.is_ok() {
+            assert!(load_with_uri(dir.path(), "null.bin").is_err());
+        }
+        if made.is_ok_and(|s| s.success()) {
+            let e = load_with_uri(dir.path(), "fifo.bin")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_buffer_is_read_no_further_than_its_byte_length() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model");
+        std::fs::create_dir_all(&model).unwrap();
+        // A side file far longer than declared: only 168 bytes are taken.
+        let mut long = cube_buffer();
+        long.resize(1 << 20, 0xff);
+        std::fs::write(model.join("long.bin"), &long).unwrap();
+        check_transformed_cube(&load_with_uri(dir.path(), "long.bin").unwrap());
+        // Shorter than declared: an error naming both lengths.
+        std::fs::write(model.join("short.bin"), &cube_buffer()[..100]).unwrap();
+        let e = load_with_uri(dir.path(), "short.bin")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("100") && e.contains("168"), "{e}");
     }
 }

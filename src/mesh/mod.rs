@@ -30,6 +30,7 @@
 //! # Ok::<(), mesh::MeshError>(())
 //! ```
 
+mod buffers;
 mod gltf;
 mod obj;
 mod stl;
@@ -177,6 +178,24 @@ pub enum MeshError {
 /// triangles, finite coordinates and a size between zero and
 /// [`MAX_EXTENT`]; anything else is a [`MeshError`].
 pub fn load(path: &Path) -> Result<Mesh, MeshError> {
+    let loader = loader(path)?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    loader(path, &bytes)
+}
+
+/// Parses `bytes` as the format `path`'s extension names, as [`load`] does
+/// once it has read the file; `path` names the file in errors, and a glTF
+/// file's buffer files are looked for in its folder.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    loader(path)?(path, bytes)
+}
+
+/// A format's parser, chosen by `path`'s extension.
+#[allow(clippy::type_complexity)]
+fn loader(path: &Path) -> Result<fn(&Path, &[u8]) -> Result<Mesh, MeshError>, MeshError> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -192,11 +211,7 @@ pub fn load(path: &Path) -> Result<Mesh, MeshError> {
             })
         }
     };
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    loader(path, &bytes)
+    Ok(loader)
 }
 
 /// Checks and tidies a freshly read triangle soup (shared by every loader).

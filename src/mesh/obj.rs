@@ -49,11 +49,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     finish(path, raw)
 }
 
-/// Checks the text line by line and returns it as a string.
+/// Checks the text line by line and returns what `tobj` is to read.
 ///
 /// Reports the first line with a bad vertex or face; `tobj` would either
 /// reject those without a line number or misread them.
-fn prescan<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshError> {
+fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
     let bad = |line: usize, reason: String| MeshError::Malformed {
         at: Location::line(path, line),
         reason,
@@ -76,6 +76,10 @@ fn prescan<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshError> {
         .filter(|(_, l)| l.split_whitespace().next() == Some("v"))
         .count();
     let mut seen = 0usize;
+    // The text handed on: comments gone, continued lines joined, and face
+    // corners cut to their vertex index (`tobj` multiplies texture and
+    // normal indices unchecked, and the mesh needs neither).
+    let mut out = String::with_capacity(text.len());
     for (no, line) in logical_lines(text) {
         if line.contains('\0') {
             return Err(bad(
@@ -115,6 +119,7 @@ fn prescan<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshError> {
                         format!("face has {} corners, needs at least 3", corners.len()),
                     ));
                 }
+                out.push('f');
                 for c in corners {
                     let first = c.split('/').next().unwrap_or("");
                     let Ok(i) = first.parse::<i64>() else {
@@ -135,12 +140,18 @@ fn prescan<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, MeshError> {
                             count,
                         });
                     }
+                    out.push(' ');
+                    out.push_str(first);
                 }
+                out.push('\n');
+                continue;
             }
             _ => {}
         }
+        out.push_str(&line);
+        out.push('\n');
     }
-    Ok(text)
+    Ok(out)
 }
 
 /// The file's statements with their 1-based starting line numbers: comments
@@ -259,6 +270,24 @@ mod tests {
         assert!(msg.contains("bad.obj:5:"), "{msg}");
         let (_, msg) = err("v 0 0 0\nv 1 0 0\nf 0 1 2\n");
         assert!(msg.contains("bad.obj:3:"), "{msg}");
+        // Texture and normal indices are not the mesh's: any of them, even
+        // huge (found by tests/fuzz.rs: `tobj` multiplied one and
+        // overflowed), leaves the triangle as it is.
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+        for corner in [
+            "1/9223372036854775807",
+            "1/2",
+            "1/-2",
+            "1//2",
+            "1/1/18446744073709551617",
+            "1/1/1",
+        ] {
+            let f = write(
+                "ok.obj",
+                format!("{tri}f {corner} 2/-1/-1 3//1\n").as_bytes(),
+            );
+            assert_eq!(load(&f.path).unwrap().triangles.len(), 1, "{corner}");
+        }
         let (_, msg) = err("v 0 0 0\nf -2 -1 -1\nv 1 0 0\n");
         assert!(msg.contains("bad.obj:2:"), "{msg}");
         let (_, msg) = err("v 0 0 0\nv 1 0 0\nf 1 x 2\n");

@@ -5,7 +5,8 @@
 //! with identical coordinates, which is what the voxelizer wants. A binary
 //! file whose length disagrees with its triangle count is reported as
 //! truncated before reading, since `stl_io` would only say "failed to fill
-//! whole buffer".
+//! whole buffer"; one holding more whole triangles than its count is an
+//! error too (a reader trusting the count would build part of the mesh).
 
 use std::io::Cursor;
 use std::path::Path;
@@ -34,6 +35,15 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             return Err(malformed(format!(
                 "binary STL is truncated: its header promises {n} triangles but the file \
                  holds {have}; re-export it"
+            )));
+        }
+        if have > n {
+            // Whole triangles past the count would be silently dropped:
+            // a build of part of the mesh. (Less than one triangle of
+            // trailing bytes is padding some exporters add.)
+            return Err(malformed(format!(
+                "binary STL header says {n} triangles but the file holds {have}; \
+                 re-export it"
             )));
         }
     }
@@ -117,6 +127,22 @@ mod tests {
         let e = load(&f.path).unwrap_err();
         assert!(matches!(e, MeshError::Malformed { .. }), "{e}");
         assert!(e.to_string().contains("junk.stl"));
+
+        // A header count lower than the triangles held: an error, not a
+        // build of the first few.
+        let mut b = binary_cube();
+        b[80..84].copy_from_slice(&5u32.to_le_bytes());
+        let f = write("low.stl", &b);
+        let e = load(&f.path).unwrap_err().to_string();
+        assert!(
+            e.contains("low.stl") && e.contains("says 5 triangles but the file holds 12"),
+            "{e}"
+        );
+        // Trailing bytes short of a triangle are padding.
+        let mut b = binary_cube();
+        b.extend([0u8; 20]);
+        let f = write("pad.stl", &b);
+        assert_eq!(load(&f.path).unwrap().triangles.len(), 12);
 
         // A header claiming zero triangles: an empty mesh.
         let f = write("empty.stl", &[0u8; 84]);

@@ -48,12 +48,31 @@ fn options() -> RenderOptions {
     RenderOptions::default()
 }
 
-/// Renders what the outputs need: step images only when `steps`.
-pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError> {
+/// Renders what the outputs need: step images only when `steps`, their
+/// count reported to `progress` as they are drawn.
+pub fn render_all(
+    p: &Pictures<'_>,
+    steps: bool,
+    progress: &dyn super::Progress,
+) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
     let step_images = if steps {
-        step_images(&renderer)
+        let total = p.assembly.step_count() as u64;
+        // The images are drawn on worker threads; each finished one is
+        // counted here, on the caller's thread.
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        std::thread::scope(|s| {
+            let worker = s.spawn(|| step_images(&renderer, tx));
+            let mut done = 0;
+            for () in rx {
+                done += 1;
+                progress.advance(done, total);
+            }
+            worker
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e))
+        })
     } else {
         Vec::new()
     };
@@ -66,15 +85,19 @@ pub fn render_all(p: &Pictures<'_>, steps: bool) -> Result<Rendered, RenderError
     })
 }
 
-/// Every step image, drawn incrementally in as many runs as threads.
-fn step_images(renderer: &StepRenderer) -> Vec<RgbaImage> {
+/// Every step image, drawn incrementally in as many runs as threads; a
+/// message on `drawn` for each.
+fn step_images(renderer: &StepRenderer, drawn: std::sync::mpsc::Sender<()>) -> Vec<RgbaImage> {
     renderer
         .runs()
         .into_par_iter()
         .map(|r| {
             renderer
                 .images_in(r)
-                .map(|(_, img)| img)
+                .map(|(_, img)| {
+                    let _ = drawn.send(());
+                    img
+                })
                 .collect::<Vec<_>>()
         })
         .collect::<Vec<_>>()
@@ -133,8 +156,12 @@ pub fn step_paths(dir: &Path, steps: usize) -> Vec<PathBuf> {
 
 /// Removes `step-NNN.png` files of an earlier, longer run from `dir`, so
 /// the directory holds exactly this build's steps. Best effort: a file
-/// that cannot be removed stays.
+/// that cannot be removed stays. A `dir` that is a symbolic link is left
+/// alone: nothing outside the output folder is deleted.
 pub fn remove_stale_steps(dir: &Path, steps: usize) {
+    if crate::fsutil::refuse_link(dir).is_err() {
+        return;
+    }
     let keep: std::collections::BTreeSet<PathBuf> = step_paths(dir, steps).into_iter().collect();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;

@@ -173,7 +173,8 @@ pub fn settle(
     supports: bool,
     replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
-    let deadline = Instant::now() + budget;
+    // A budget too large for the clock is no budget (about 31 years).
+    let deadline = Instant::now() + budget.min(Duration::from_secs(1_000_000_000));
     let mut counts = Counts::default();
     let first = attempt(
         plan,

@@ -355,7 +355,7 @@ impl<'a> Layout<'a> {
             }
             let seed: u64 = dice.rules.gen();
             // The course's own direction first: among equal layers it wins.
-            let along_x = (z / self.course) % 2 == 0;
+            let along_x = (z / self.course).rem_euclid(2) == 0;
             let scans: Vec<Scan> = [along_x, !along_x]
                 .into_iter()
                 .flat_map(|ax| {
@@ -444,7 +444,8 @@ impl<'a> Layout<'a> {
     fn cover(&mut self, c: Cell, opts: &SearchOptions, dice: &mut Dice) {
         self.stats.nodes += 1;
         let k = u64::from(opts.complex_every);
-        if k > 0 && self.stats.nodes % k == 0 && !self.rules.complex_variants().is_empty() {
+        if k > 0 && self.stats.nodes.is_multiple_of(k) && !self.rules.complex_variants().is_empty()
+        {
             self.stats.complex_tried += 1;
             let n = self.rules.complex_variants().len();
             let variant = dice.complex.gen_range(0..n) as u32;

@@ -485,10 +485,26 @@ fn the_rule_file_names_the_builds_and_round_trips() {
         ]
     );
     let rs = RuleSet::parse(&file, Path::new("l.rules")).unwrap();
-    assert_eq!(rs.alphabet(), [kind("3005"), kind("3004"), kind("3001")]);
-    assert_eq!(rs.starts().len(), 3);
+    // The parts seen, and the rest of the built-in alphabet beside them.
+    assert_eq!(rs.alphabet().len(), crate::grammar::DEFAULT_ALPHABET.len());
+    for id in ["3005", "3004", "3001", "3003", "3024", "3039"] {
+        assert!(rs.alphabet().contains(&kind(id)), "{id}");
+    }
+    assert_eq!(rs.starts().len(), rs.alphabet().len());
+    assert!(
+        file.contains("Parts: the 3 the builds used, and 18 more"),
+        "{file}"
+    );
     assert_eq!(rs.variants(), l.rule_set().variants());
     assert_eq!(rs.to_text("x"), l.rule_set().to_text("x"));
+    // Restricted to the parts seen.
+    let seen = l.clone().seen_parts_only().unwrap();
+    let text = seen.to_rules_text();
+    assert!(!text.contains("Parts: "), "{text}");
+    let rs = RuleSet::parse(&text, Path::new("l.rules")).unwrap();
+    assert_eq!(rs.alphabet(), [kind("3005"), kind("3004"), kind("3001")]);
+    assert_eq!(rs.starts().len(), 3);
+    assert_eq!(rs.variants(), seen.rule_set().variants());
 }
 
 #[test]
@@ -622,7 +638,9 @@ fn a_slope_on_a_brick_and_a_brick_on_a_slopes_back_row_are_learned() {
             (1, 12),
             "slopes need half-brick layers"
         );
-        let rs = loads(&l);
+        // Over the parts seen (the built-in alphabet has plates, and its
+        // layers would be a plate high).
+        let rs = loads(&l.clone().seen_parts_only().unwrap());
         // Slopes look different every way: four variants a rule.
         assert_eq!((rs.rules().len(), rs.variants().len()), (2, 8));
         assert_eq!(rs.layer_ldu(), 12);
