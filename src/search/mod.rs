@@ -24,6 +24,7 @@
 //! piece scored against a fixed set of candidates over it, and bodies are
 //! tracked with a union-find.
 
+mod complex;
 mod derive;
 mod join;
 mod layout;

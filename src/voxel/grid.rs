@@ -149,16 +149,6 @@ impl VoxelGrid {
         false
     }
 
-    /// Whether every cell a piece fills is filled here.
-    pub fn all_set_body(&self, b: &Body) -> bool {
-        b.boxes().iter().all(|x| self.all_set(x))
-    }
-
-    /// Whether any cell a piece fills is filled here.
-    pub fn any_set_body(&self, b: &Body) -> bool {
-        b.boxes().iter().any(|x| self.any_set(x))
-    }
-
     /// Fills or clears every cell a piece fills (inside the grid).
     pub fn set_body(&mut self, b: &Body, on: bool) {
         for x in b.boxes() {
@@ -235,36 +225,6 @@ impl VoxelGrid {
                 })
             })
         })
-    }
-
-    /// The first filled cell of layer `z` at or after `(x, y)` in raster
-    /// order (x fastest), if any.
-    pub fn next_in_layer(&self, z: i32, mut y: i32, x: i32) -> Option<Cell> {
-        if z < 0 || z >= self.nz {
-            return None;
-        }
-        let mut x = x.max(0);
-        while y < self.ny {
-            if x < self.nx {
-                let r = self.row(y, z);
-                let mut w = x as usize >> 6;
-                let mut word = self.bits[r + w] & (u64::MAX << (x & 63));
-                loop {
-                    if word != 0 {
-                        let cx = (w as i32) * 64 + word.trailing_zeros() as i32;
-                        return Some(Cell::new(cx, y, z));
-                    }
-                    w += 1;
-                    if w >= self.words_per_row {
-                        break;
-                    }
-                    word = self.bits[r + w];
-                }
-            }
-            y += 1;
-            x = 0;
-        }
-        None
     }
 
     /// Every filled cell, layer by layer from the bottom, raster order within.
