@@ -84,6 +84,15 @@ fn bench(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("steps/mug", mug.pieces.len()), |b| {
         b.iter(|| analyze_steps(&mug, &params, false).expect("solves"))
     });
+    // Organic builds at the sizes the issue names: every step of the mug
+    // (a curved shell with an overhanging handle) at 48 and 64 studs.
+    for studs in [48, 64] {
+        let mug = fixture_build("mug.obj", studs);
+        group.bench_function(
+            BenchmarkId::new(format!("steps/mug-{studs}"), mug.pieces.len()),
+            |b| b.iter(|| analyze_steps(&mug, &params, false).expect("solves")),
+        );
+    }
     let arch = fixture_build("arch.obj", 24);
     let fails = analyze_steps(&arch, &params, false)
         .expect("solves")
