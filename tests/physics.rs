@@ -343,3 +343,72 @@ fn bad_parameters_are_an_error_not_a_panic() {
     let s = analyze_steps(&empty, &Params::default(), true).unwrap();
     assert!(s.steps.is_empty() && s.first_failure.is_none());
 }
+
+/// The search's build of a fixture mesh, searched, sequenced and grouped
+/// as `build` does it (bricks only).
+fn fixture_build(name: &str, studs: u32) -> Assembly {
+    use brickwright::assembly::order::by_course;
+    use brickwright::catalog::Family;
+    use brickwright::search::{self, SearchOptions};
+    use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name);
+    let mesh = brickwright::mesh::load(&path).expect("fixture loads");
+    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
+    let model = voxelize(&mesh, &opts).expect("fixture voxelizes");
+    let rules = brickwright::pipeline::load_rules(None)
+        .expect("the default rules load")
+        .restricted(|p| p.spec().family() == Family::Brick)
+        .expect("brick rules");
+    let outcome = search::build_guided(
+        &model.grid,
+        Some(&model.slant),
+        &rules,
+        &SearchOptions::default(),
+    )
+    .expect("a build");
+    let order = search::placements(&outcome);
+    let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
+    a.regroup(StepGrouping::Auto);
+    a
+}
+
+/// The step check reuses and certifies what it can; on real builds every
+/// step must read as a full solve of that step's structure does: the same
+/// verdict, the same lowest score (1 - the highest usage) within 1e-3,
+/// and the same usage of every piece of the finished build.
+#[test]
+fn every_step_of_a_real_build_agrees_with_a_full_solve() {
+    let params = Params::default();
+    for (name, studs) in [("mug.obj", 24), ("arch.obj", 24)] {
+        let asm = fixture_build(name, studs);
+        let fast = analyze_steps(&asm, &params, false).unwrap();
+        assert!(fast.complete);
+        assert_eq!(fast.steps.len() as u32, asm.step_count(), "{name}");
+        for check in &fast.steps {
+            let prefix = Assembly {
+                pieces: asm
+                    .pieces
+                    .iter()
+                    .filter(|p| p.step.0 <= check.step)
+                    .cloned()
+                    .collect(),
+                layer_ldu: asm.layer_ldu,
+            };
+            let full = analyze(&prefix, &params).unwrap();
+            assert_eq!(check.stands, full.stands(), "{name} step {}", check.step);
+            assert!(
+                (check.min_score - full.min_score).abs() <= 1e-3,
+                "{name} step {}: {} against {}",
+                check.step,
+                check.min_score,
+                full.min_score
+            );
+        }
+        let whole = analyze(&asm, &params).unwrap();
+        for (a, b) in fast.last.pieces.iter().zip(&whole.pieces) {
+            assert!((a.usage - b.usage).abs() <= 1e-3, "{name}");
+        }
+    }
+}

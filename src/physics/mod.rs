@@ -91,6 +91,14 @@
 //! is an interior-point solver with no warm start; this certificate is the
 //! reuse of the previous solution.) The finished build is solved afresh.
 //!
+//! Before any program is solved, the group gets a second, exact
+//! certificate: when every piece's weight can be passed down to the ground
+//! through the faces pieces rest on, spread over several supports where
+//! need be, the group stands on compression alone, and since no cost is
+//! negative that answer (no clutch, no hand) is the program's optimum
+//! (`compression` module). Solid builds need no solve at all this way,
+//! their finished model included.
+//!
 //! # Example
 //!
 //! ```
@@ -112,6 +120,7 @@
 //! assert!(a.pieces[1].usage > 0.0 && a.pieces[1].usage < 1.0);
 //! ```
 
+mod compression;
 mod model;
 pub mod repair;
 mod steps;
@@ -350,6 +359,10 @@ pub struct StepsAnalysis {
     /// untouched, or grown only by pieces resting straight on the ground
     /// through compression.
     pub reused: usize,
+    /// Groups found to stand on compression alone without a solve: every
+    /// weight passes down to the ground through the faces pieces rest on
+    /// (exact: no clutch is used, see the module docs).
+    pub certified: usize,
     /// Every step up to the end (or the first failure, when asked to stop
     /// there) was checked; false when the deadline of
     /// [`analyze_steps_within`] cut the check short.

@@ -88,6 +88,8 @@ struct Load {
     ground: Option<Rect>,
     /// Its tubes on a baseplate's studs ([`Ground::Baseplate`] only).
     ground_studs: Vec<(f64, f64)>,
+    /// The layer of its bottom.
+    z: i32,
 }
 
 /// The assembly seen as loads and contacts, built once.
@@ -164,6 +166,37 @@ impl Structure {
     pub fn grounded(&self, piece: usize) -> bool {
         self.loads[piece].ground.is_some()
     }
+
+    /// The piece's weight (in clutch capacities) and centre of mass.
+    pub fn weight(&self, piece: usize) -> (f64, (f64, f64)) {
+        (self.loads[piece].weight, self.loads[piece].com)
+    }
+
+    /// The layer of the piece's bottom.
+    pub fn bottom(&self, piece: usize) -> i32 {
+        self.loads[piece].z
+    }
+
+    /// Where `piece` can push down in compression on the pieces `placed`
+    /// accepts: each corner of a face under it, with the piece below
+    /// (`None` for the ground), a face's four corners in a row.
+    pub fn supports(
+        &self,
+        piece: usize,
+        placed: impl Fn(usize) -> bool,
+    ) -> Vec<(Option<usize>, (f64, f64))> {
+        let mut out = Vec::new();
+        for &k in &self.under[piece] {
+            let c = &self.contacts[k];
+            if let (true, Some(face)) = (placed(c.below), c.face) {
+                out.extend(face.corners().map(|at| (Some(c.below), at)));
+            }
+        }
+        if let Some(g) = self.loads[piece].ground {
+            out.extend(g.corners().map(|at| (None, at)));
+        }
+        out
+    }
 }
 
 fn load(b: &Body, mass_g: f32, params: &Params) -> Load {
@@ -188,6 +221,7 @@ fn load(b: &Body, mass_g: f32, params: &Params) -> Load {
         extent: Rect::of(&b.bbox),
         ground: on_ground.then(|| Rect::of(&bottom)),
         ground_studs,
+        z: b.bbox.min.z,
     }
 }
 

@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 use crate::assembly::Assembly;
 
+use super::compression;
 use super::model::{solve, Contact, Structure};
 use super::{weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis};
 
@@ -102,19 +103,36 @@ fn drops(s: &Structure, job: &Job, begin: usize, end: usize) -> bool {
         .all(|&p| p < begin || s.drops_straight(p, end))
 }
 
+/// How a job's answer was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Found {
+    /// The group does not reach the ground: it falls, no program needed.
+    Falls,
+    /// Every weight passes down in compression ([`compression::holds`]).
+    Certified,
+    /// The program was solved.
+    Solved,
+}
+
 /// [`run`] on borrowed jobs.
 fn run_refs(
     s: &Structure,
     jobs: &[&Job],
     params: &Params,
-) -> Result<Vec<Vec<PieceStress>>, PhysicsError> {
+) -> Result<Vec<(Vec<PieceStress>, Found)>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
             if !job.grounded {
-                return Ok(vec![PieceStress::falling(); job.pieces.len()]);
+                return Ok((vec![PieceStress::falling(); job.pieces.len()], Found::Falls));
+            }
+            if compression::holds(s, &job.pieces) {
+                return Ok((
+                    vec![PieceStress::resting(); job.pieces.len()],
+                    Found::Certified,
+                ));
             }
             let contacts: Vec<&Contact> = job.contacts.iter().map(|&k| &s.contacts[k]).collect();
-            solve(s, &job.pieces, &contacts, params).map(|r| r.stress)
+            solve(s, &job.pieces, &contacts, params).map(|r| (r.stress, Found::Solved))
         })
         .collect()
 }
@@ -124,7 +142,7 @@ fn run(
     s: &Structure,
     jobs: &[Job],
     params: &Params,
-) -> Result<Vec<Vec<PieceStress>>, PhysicsError> {
+) -> Result<Vec<(Vec<PieceStress>, Found)>, PhysicsError> {
     run_refs(s, &jobs.iter().collect::<Vec<_>>(), params)
 }
 
@@ -139,7 +157,7 @@ pub(super) fn solve_all(
     let jobs = jobs_for_step(s, &mut g, &mut next, n, &mut reused);
     let results = run(s, &jobs, params)?;
     let mut out = vec![PieceStress::falling(); n];
-    for (job, r) in jobs.iter().zip(results) {
+    for (job, (r, _)) in jobs.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
         }
@@ -213,7 +231,7 @@ pub fn analyze_steps_from(
         }
     }
     let mut g = Groups::new();
-    let (mut next, mut reused, mut solves) = (0, 0, 0);
+    let (mut next, mut reused, mut solves, mut certified) = (0, 0, 0, 0);
     let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
@@ -291,8 +309,10 @@ pub fn analyze_steps_from(
                 .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
                 .collect();
             let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
-            solves += batch_jobs.iter().filter(|j| j.grounded).count();
-            solved.extend(batch.into_iter().zip(run_refs(&s, &batch_jobs, params)?));
+            let results = run_refs(&s, &batch_jobs, params)?;
+            solves += results.iter().filter(|r| r.1 == Found::Solved).count();
+            certified += results.iter().filter(|r| r.1 == Found::Certified).count();
+            solved.extend(batch.into_iter().zip(results.into_iter().map(|r| r.0)));
         }
         let (step, end) = bounds[k];
         let mut late = Vec::new();
@@ -314,8 +334,10 @@ pub fn analyze_steps_from(
                 late.push(job);
             }
         }
-        solves += late.iter().filter(|j| j.grounded).count();
-        for (job, r) in late.iter().zip(run_refs(&s, &late, params)?) {
+        let results = run_refs(&s, &late, params)?;
+        solves += results.iter().filter(|r| r.1 == Found::Solved).count();
+        certified += results.iter().filter(|r| r.1 == Found::Certified).count();
+        for (job, (r, _)) in late.iter().zip(results) {
             for (&p, st) in job.pieces.iter().zip(r) {
                 current[p] = st;
             }
@@ -355,6 +377,7 @@ pub fn analyze_steps_from(
         seconds,
         solves,
         reused,
+        certified,
         complete,
     })
 }
