@@ -236,6 +236,9 @@ pub(crate) struct Layout<'a> {
     layer_score: f64,
 }
 
+/// Layers of more separate patches than this are laid as a whole.
+const MAX_REGIONS: usize = 1024;
+
 /// What a layer's piece costs in its score, in voxels: the layer laid with
 /// fewer pieces scores higher.
 const PIECE_COST: f64 = 3.0;
@@ -333,11 +336,11 @@ impl<'a> Layout<'a> {
 
     /// Lays every layer, bottom first, until done or `deadline`.
     ///
-    /// Each layer is laid several ways (scanning from each corner, long
-    /// pieces along either axis, see [`Scan`]) and the way with the best
-    /// total score is kept: greedy choices made at one end of a course
-    /// decide where its seams fall at the other, so the layer as a whole is
-    /// compared.
+    /// Each patch of a layer is laid several ways (scanning from each
+    /// corner, long pieces along either axis, see [`Scan`]) and the way
+    /// with the best total score is kept: greedy choices made at one end of
+    /// a course decide where its seams fall at the other, so the patch as a
+    /// whole is compared.
     pub fn lay(&mut self, opts: &SearchOptions, dice: &mut Dice, deadline: Instant) {
         let (_, _, nz) = self.dims;
         for z in 0..nz {
@@ -353,39 +356,89 @@ impl<'a> Layout<'a> {
             if self.must.count_layer(z) == 0 {
                 continue;
             }
-            let seed: u64 = dice.rules.gen();
-            // The course's own direction first: among equal layers it wins.
-            let along_x = (z / self.course).rem_euclid(2) == 0;
-            let scans: Vec<Scan> = [along_x, !along_x]
-                .into_iter()
-                .flat_map(|ax| {
-                    (0..4).map(move |corner| Scan {
-                        along_x: ax,
-                        flip_x: corner & 1 == 1,
-                        flip_y: corner & 2 == 2,
-                    })
-                })
-                .collect();
-            let mut best: Option<(f64, usize)> = None;
-            if scans.len() > 1 {
-                let saved = (
-                    self.pieces.len(),
-                    self.groups.len(),
-                    self.uf.clone(),
-                    self.stats.clone(),
-                    self.repairs.clone(),
-                );
-                for (k, scan) in scans.iter().enumerate() {
-                    let score = self.lay_layer(z, *scan, opts, &mut Dice::new(seed ^ k as u64));
-                    if best.is_none_or(|b| score > b.0) {
-                        best = Some((score, k));
-                    }
-                    self.undo_to(&saved);
+            // Each separate patch of the layer (a leg, a wall, a rod) is laid
+            // the best way for itself; a layer of very many patches is laid
+            // as a whole.
+            let regions = self.layer_regions(z);
+            if regions.len() <= MAX_REGIONS {
+                for region in &regions {
+                    self.lay_best(z, Some(region), opts, dice);
                 }
+            } else {
+                self.lay_best(z, None, opts, dice);
             }
-            let k = best.map_or(0, |b| b.1);
-            self.lay_layer(z, scans[k], opts, &mut Dice::new(seed ^ k as u64));
         }
+    }
+
+    /// The patches of free voxels of layer `z`, joined through their faces.
+    fn layer_regions(&self, z: i32) -> Vec<Vec<Cell>> {
+        let (nx, ny, _) = self.dims;
+        let mut seen = vec![false; (nx * ny) as usize];
+        let at = |c: Cell| (c.y * nx + c.x) as usize;
+        let mut out = Vec::new();
+        for c in self.must.layer_cells(z) {
+            if seen[at(c)] || !self.free(c) {
+                continue;
+            }
+            seen[at(c)] = true;
+            let mut region = vec![c];
+            let mut k = 0;
+            while k < region.len() {
+                for n in neighbors6(region[k])[..4].iter().copied() {
+                    if self.must.get(n) && self.free(n) && !seen[at(n)] {
+                        seen[at(n)] = true;
+                        region.push(n);
+                    }
+                }
+                k += 1;
+            }
+            out.push(region);
+        }
+        out
+    }
+
+    /// Lays the free voxels of layer `z` (those of `region` only, if
+    /// given) each of the eight ways, and keeps the best.
+    fn lay_best(
+        &mut self,
+        z: i32,
+        region: Option<&Vec<Cell>>,
+        opts: &SearchOptions,
+        dice: &mut Dice,
+    ) {
+        let seed: u64 = dice.rules.gen();
+        // The course's own direction first: among equal layers it wins.
+        let along_x = (z / self.course).rem_euclid(2) == 0;
+        let scans: Vec<Scan> = [along_x, !along_x]
+            .into_iter()
+            .flat_map(|ax| {
+                (0..4).map(move |corner| Scan {
+                    along_x: ax,
+                    flip_x: corner & 1 == 1,
+                    flip_y: corner & 2 == 2,
+                })
+            })
+            .collect();
+        let mut best: Option<(f64, usize)> = None;
+        // A patch of one or two voxels has little to choose.
+        if region.is_none_or(|r| r.len() > 2) {
+            let saved = (
+                self.pieces.len(),
+                self.groups.len(),
+                self.uf.clone(),
+                self.stats.clone(),
+                self.repairs.clone(),
+            );
+            for (k, scan) in scans.iter().enumerate() {
+                let score = self.lay_layer(z, *scan, region, opts, &mut Dice::new(seed ^ k as u64));
+                if best.is_none_or(|b| score > b.0) {
+                    best = Some((score, k));
+                }
+                self.undo_to(&saved);
+            }
+        }
+        let k = best.map_or(0, |b| b.1);
+        self.lay_layer(z, scans[k], region, opts, &mut Dice::new(seed ^ k as u64));
     }
 
     /// Takes out every piece laid since `saved` was taken.
@@ -406,34 +459,38 @@ impl<'a> Layout<'a> {
         self.repairs = saved.4.clone();
     }
 
-    /// Lays layer `z` scanning as `scan` says; returns the layer's score:
-    /// its pieces' scores, less a fixed cost a piece.
-    fn lay_layer(&mut self, z: i32, scan: Scan, opts: &SearchOptions, dice: &mut Dice) -> f64 {
-        let (nx, ny, _) = self.dims;
+    /// Lays layer `z` (the voxels of `region` only, if given) scanning as
+    /// `scan` says; returns the layer's score: its pieces' scores, less a
+    /// fixed cost a piece.
+    fn lay_layer(
+        &mut self,
+        z: i32,
+        scan: Scan,
+        region: Option<&Vec<Cell>>,
+        opts: &SearchOptions,
+        dice: &mut Dice,
+    ) -> f64 {
         self.along_x = scan.along_x;
         self.layer_score = 0.0;
-        let xs: Vec<i32> = if scan.flip_x {
-            (0..nx).rev().collect()
-        } else {
-            (0..nx).collect()
+        // Rows along the long pieces' direction, one after the other, from
+        // the scan's corner.
+        let key = |c: &Cell| {
+            let x = if scan.flip_x { -c.x } else { c.x };
+            let y = if scan.flip_y { -c.y } else { c.y };
+            if scan.along_x {
+                (y, x)
+            } else {
+                (x, y)
+            }
         };
-        let ys: Vec<i32> = if scan.flip_y {
-            (0..ny).rev().collect()
-        } else {
-            (0..ny).collect()
+        let mut cells: Vec<Cell> = match region {
+            Some(r) => r.clone(),
+            None => self.must.layer_cells(z).collect(),
         };
-        // Rows along the long pieces' direction, one after the other.
-        let (outer, inner) = if scan.along_x { (&ys, &xs) } else { (&xs, &ys) };
-        for &a in outer {
-            for &b in inner {
-                let c = if scan.along_x {
-                    Cell::new(b, a, z)
-                } else {
-                    Cell::new(a, b, z)
-                };
-                if self.must.get(c) && self.free(c) {
-                    self.cover(c, opts, dice);
-                }
+        cells.sort_by_key(key);
+        for c in cells {
+            if self.free(c) {
+                self.cover(c, opts, dice);
             }
         }
         self.layer_score
