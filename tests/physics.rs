@@ -363,7 +363,10 @@ fn fixture_build(name: &str, studs: u32) -> Assembly {
         .expect("brick rules");
     let outcome = search::build_guided(
         &model.grid,
-        Some(&model.slant),
+        search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+        },
         &rules,
         &SearchOptions::default(),
     )
