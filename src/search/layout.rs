@@ -220,6 +220,10 @@ pub(crate) struct Layout<'a> {
     /// Empty cells the surface passes through.
     pub near: VoxelGrid,
     pub slant: Option<&'a Slant>,
+    /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
+    /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
+    /// only, so colour boundaries fall between pieces.
+    pub colors: Option<&'a [u16]>,
     pub shapes: Vec<PieceShape>,
     pub weights: Weights,
     /// The piece owning each cell, or [`NONE`].
@@ -304,6 +308,7 @@ impl<'a> Layout<'a> {
             must,
             near,
             slant,
+            colors: None,
             shapes: shapes(rules),
             weights: Weights::default(),
             owner: vec![NONE; must.len()],
@@ -516,7 +521,8 @@ impl<'a> Layout<'a> {
 
     /// Whether the piece `body` fits: every cell free and allowed by
     /// `reach`, a slope's open face clear of the model and of pieces and
-    /// slanting the way the mesh does. Returns how many cells it fills of
+    /// slanting the way the mesh does, and on the visible surface of one
+    /// colour (see [`Layout::colors`]). Returns how many cells it fills of
     /// the model's voxels, of the cells the surface passes through, and of
     /// other empty cells.
     fn fits(
@@ -526,10 +532,20 @@ impl<'a> Layout<'a> {
         reach: Reach,
     ) -> Option<(usize, usize, usize)> {
         let (mut inside, mut outside, mut far) = (0, 0, 0);
+        let mut label = 0u16;
         for b in body.boxes() {
             for q in b.cells() {
                 if !self.free(q) {
                     return None;
+                }
+                if let Some(colors) = self.colors {
+                    let l = colors.get(self.must.index(q)).copied().unwrap_or(0);
+                    if l != 0 {
+                        if label != 0 && l != label {
+                            return None;
+                        }
+                        label = l;
+                    }
                 }
                 if self.must.get(q) {
                     inside += 1;
