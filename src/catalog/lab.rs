@@ -182,7 +182,7 @@ mod tests {
 
     #[test]
     fn nearest_picks_the_obvious_bricks() {
-        assert_eq!(nearest([0, 0, 255]), Color(1));
+        assert_eq!(nearest([30, 90, 170]), Color(1));
         assert_eq!(nearest([255, 220, 0]), Color(14));
         assert_eq!(nearest([10, 10, 10]), Color(0));
         assert_eq!(nearest([40, 160, 60]), Color(2));

@@ -74,13 +74,16 @@ pub fn color_voxels(
             .max((p[2] - p[0]).length())
             .max((p[2] - p[1]).length());
         let steps = (span * 3.0).ceil().clamp(1.0, 4096.0) as usize;
+        // A sample on a cell boundary (a face flush with the grid) belongs
+        // to the cell behind the face: step a hair inward.
+        let inward = -(p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero() * 0.01;
         for i in 0..=steps {
             for j in 0..=(steps - i) {
                 let (a, b) = (i as f32 / steps as f32, j as f32 / steps as f32);
                 // Pull samples a hair toward the centroid so a corner
                 // shared by two materials is not a tie.
                 let (a, b) = (a * 0.98 + 0.0066, b * 0.98 + 0.0066);
-                let q: Vec3 = p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b;
+                let q: Vec3 = p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b + inward;
                 let c = Cell::new(q.x.floor() as i32, q.y.floor() as i32, q.z.floor() as i32);
                 if !grid.in_bounds(c) {
                     continue;
