@@ -89,7 +89,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |name| {
         let shown = name.display().to_string();
         let bytes = super::paint::inside_folder(folder, &shown)
-            .ok_or_else(|| format!("is outside the model's folder"))
+            .ok_or_else(|| "is outside the model's folder".to_string())
             .and_then(|p| read_bounded(&p));
         match bytes {
             Ok(b) => tobj::load_mtl_buf(&mut b.as_slice()).or_else(|e| {
