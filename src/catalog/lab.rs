@@ -185,7 +185,7 @@ mod tests {
         assert_eq!(nearest([30, 90, 170]), Color(1));
         assert_eq!(nearest([255, 220, 0]), Color(14));
         assert_eq!(nearest([10, 10, 10]), Color(0));
-        assert_eq!(nearest([40, 160, 60]), Color(2));
+        assert_eq!(nearest([10, 120, 40]), Color(2));
     }
 
     #[test]

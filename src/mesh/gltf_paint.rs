@@ -235,3 +235,81 @@ fn read_floats(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::{cube, write};
+    use super::super::{load, Mesh};
+
+    fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+        let mut j = json.as_bytes().to_vec();
+        while j.len() % 4 != 0 {
+            j.push(b' ');
+        }
+        let mut b = bin.to_vec();
+        while b.len() % 4 != 0 {
+            b.push(0);
+        }
+        let mut out = b"glTF".to_vec();
+        out.extend(2u32.to_le_bytes());
+        out.extend(((28 + j.len() + b.len()) as u32).to_le_bytes());
+        out.extend((j.len() as u32).to_le_bytes());
+        out.extend(b"JSON");
+        out.extend(j);
+        out.extend((b.len() as u32).to_le_bytes());
+        out.extend(b"BIN\0");
+        out.extend(b);
+        out
+    }
+
+    /// The unit cube twice: primitive 0 with `COLOR_0` (normalized u8
+    /// RGBA: red at z = 0, green at z = 1) and no material, primitive 1
+    /// with a material whose factor is blue and whose texture is a missing
+    /// file.
+    fn coloured_cube() -> Mesh {
+        let (v, t) = cube();
+        let mut b: Vec<u8> = v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        for p in &v {
+            b.extend(if p[2] == 0.0 {
+                [255, 0, 0, 255]
+            } else {
+                [0, 255, 0, 255]
+            });
+        }
+        b.extend(t.iter().flatten().flat_map(|&i| (i as u16).to_le_bytes()));
+        let json = r#"{"asset": {"version": "2.0"},
+  "meshes": [{"primitives": [
+    {"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2},
+    {"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 1, 1],
+    "baseColorTexture": {"index": 0}}}],
+  "textures": [{"source": 0}],
+  "images": [{"uri": "missing.png"}],
+  "buffers": [{"byteLength": 200}],
+  "bufferViews": [{"buffer": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 32},
+    {"buffer": 0, "byteOffset": 128, "byteLength": 72}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+    {"bufferView": 1, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"},
+    {"bufferView": 2, "componentType": 5123, "count": 36, "type": "SCALAR"}]}"#;
+        let f = write("coloured.glb", &glb(json, &b));
+        load(&f.path).unwrap()
+    }
+
+    #[test]
+    fn color_0_and_base_color_factor_for_every_primitive() {
+        let m = coloured_cube();
+        let paint = m.paint.as_ref().expect("colours are read");
+        assert_eq!(m.triangles.len(), 24);
+        assert_eq!(paint.faces.len(), 24);
+        // The z = 0 face of primitive 0 (its first two triangles) is red.
+        assert_eq!(paint.sample(0, [1.0 / 3.0; 3]), [1.0, 0.0, 0.0]);
+        // Its z = 1 face is green.
+        assert_eq!(paint.sample(2, [1.0 / 3.0; 3]), [0.0, 1.0, 0.0]);
+        // Primitive 1: the material's factor, blue.
+        assert_eq!(paint.sample(12, [1.0 / 3.0; 3]), [0.0, 0.0, 1.0]);
+        // The missing texture is a warning naming it.
+        assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+        assert!(m.warnings[0].contains("missing.png"), "{:?}", m.warnings);
+    }
+}

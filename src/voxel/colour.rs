@@ -66,7 +66,7 @@ pub fn color_voxels(
     let all: Vec<Color> = COLORS.iter().map(|c| c.code).collect();
     let mut cache: HashMap<[u8; 3], Color> = HashMap::new();
     let cell = model.cell_size();
-    let mut votes: Vec<(u32, Color)> = Vec::new();
+    let mut votes: Vec<(u32, Color, u32)> = Vec::new();
     for (k, t) in mesh.triangles.iter().enumerate() {
         let p = t.map(|i| (to_grid_frame(mesh.positions[i as usize], up) - model.origin) / cell);
         let span = (p[1] - p[0])
@@ -94,7 +94,12 @@ pub fn color_voxels(
                 let lego = *cache
                     .entry(key)
                     .or_insert_with(|| lab::nearest_in(key, &all));
-                votes.push((grid.index(c) as u32, lego));
+                let idx = grid.index(c) as u32;
+                // Runs of samples in one cell and colour count as one entry.
+                match votes.last_mut() {
+                    Some(v) if v.0 == idx && v.1 == lego => v.2 += 1,
+                    _ => votes.push((idx, lego, 1)),
+                }
             }
         }
     }
@@ -105,13 +110,14 @@ pub fn color_voxels(
         let idx = votes[run].0;
         let end = run + votes[run..].partition_point(|v| v.0 == idx);
         // Most votes; ties to the lower code.
-        let mut best = (0usize, Color(u16::MAX));
+        let mut best = (0u32, Color(u16::MAX));
         let mut i = run;
         while i < end {
             let c = votes[i].1;
             let n = votes[i..end].partition_point(|v| v.1 == c);
-            if n > best.0 {
-                best = (n, c);
+            let w: u32 = votes[i..i + n].iter().map(|v| v.2).sum();
+            if w > best.0 {
+                best = (w, c);
             }
             i += n;
         }
