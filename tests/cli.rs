@@ -855,3 +855,33 @@ fn complex_rules_are_tested_every_k_nodes_or_never() {
     assert_eq!(off["search"]["complex_tried"], 0);
     assert_eq!(off["search"]["complex_applied"], 0);
 }
+
+#[test]
+fn the_mesh_palette_is_the_default_and_colors_limits_it() {
+    let (ldr, report) = build_verified("two_tone.obj", &[]);
+    assert_eq!(report["options"]["palette"], "mesh", "{report}");
+    assert_eq!(report["mesh_colors"]["colors"].as_array().unwrap().len(), 2);
+    assert!(ldr.lines().any(|l| l.starts_with("1 4 ")), "no red piece");
+    assert!(ldr.lines().any(|l| l.starts_with("1 1 ")), "no blue piece");
+    let (ldr, report) = build_verified("two_tone.obj", &["--colors", "1"]);
+    assert_eq!(report["mesh_colors"]["colors"].as_array().unwrap().len(), 1);
+    let codes: std::collections::BTreeSet<&str> = ldr
+        .lines()
+        .filter(|l| l.starts_with("1 "))
+        .filter_map(|l| l.split_whitespace().nth(1))
+        .collect();
+    assert_eq!(codes.len(), 1, "{codes:?}");
+    let (ldr, _) = build_verified("two_tone.obj", &["--palette", "layers"]);
+    assert!(
+        ldr.lines().any(|l| l.starts_with("1 15 ")),
+        "layers paint white"
+    );
+    let tmp = tempdir();
+    let run = build(
+        tmp.path(),
+        &fixture("two_tone.obj"),
+        &tmp.path().join("o"),
+        &["--colors", "0"],
+    );
+    assert_ne!(run.code, Some(0));
+}
