@@ -423,3 +423,63 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod colour_tests {
+    use super::super::load;
+
+    /// A quad with texture coordinates, its MTL naming a 2 x 2 PNG (top
+    /// row red, bottom row blue) beside it; and a vertex-coloured triangle.
+    #[test]
+    fn map_kd_textures_and_vertex_colours() {
+        let dir = tempfile::tempdir().unwrap();
+        let img = image::RgbImage::from_fn(2, 2, |_, y| {
+            image::Rgb(if y == 0 { [255, 0, 0] } else { [0, 0, 255] })
+        });
+        img.save(dir.path().join("tex.png")).unwrap();
+        std::fs::write(
+            dir.path().join("m.mtl"),
+            "newmtl t\nKd 1 1 1\nmap_Kd tex.png\n",
+        )
+        .unwrap();
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                   vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+        let path = dir.path().join("q.obj");
+        std::fs::write(&path, obj).unwrap();
+        let m = load(&path).unwrap();
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        let p = m.paint.as_ref().unwrap();
+        // OBJ's v counts up: v = 0 is the image's bottom row (blue).
+        assert_eq!(p.sample(0, [0.9, 0.05, 0.05]), [0.0, 0.0, 1.0]);
+        assert_eq!(p.sample(1, [0.05, 0.05, 0.9]), [1.0, 0.0, 0.0]);
+
+        let path = dir.path().join("vc.obj");
+        std::fs::write(
+            &path,
+            "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let m = load(&path).unwrap();
+        let p = m.paint.as_ref().unwrap();
+        assert_eq!(p.sample(0, [1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]);
+        assert_eq!(p.sample(0, [0.0, 0.0, 1.0]), [0.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn a_material_library_outside_the_folder_is_not_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.obj");
+        std::fs::write(
+            &path,
+            "mtllib ../secret.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let m = load(&path).unwrap();
+        assert!(m.paint.is_none());
+        assert!(
+            m.warnings.len() == 1 && m.warnings[0].contains("outside"),
+            "{:?}",
+            m.warnings
+        );
+    }
+}
