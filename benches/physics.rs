@@ -57,6 +57,7 @@ fn fixture_build(name: &str, studs: u32) -> Assembly {
         search::Guide {
             slant: Some(&model.slant),
             surface: Some(&model.surface),
+            colors: None,
         },
         &rules,
         &SearchOptions::default(),

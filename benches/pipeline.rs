@@ -66,6 +66,7 @@ fn uv_sphere(rings: u32) -> Mesh {
     Mesh {
         positions,
         triangles,
+        ..Mesh::default()
     }
 }
 

@@ -12,6 +12,7 @@ use serde::Serialize;
 use crate::geom::{Body, Cell, CellBox, Rot, MAX_BODY_BOXES};
 
 mod color;
+pub mod lab;
 pub use color::{Color, ColorSpec, Palette, COLORS, LAYER_PALETTE, RANDOM_PALETTE};
 
 /// An LDraw part file name without its `.dat` extension, e.g. `3001`.

@@ -192,7 +192,7 @@ fn parse_color(s: &str) -> Result<brickwright::catalog::Color, String> {
 
 fn parse_palette(s: &str) -> Result<brickwright::catalog::Palette, String> {
     brickwright::catalog::Palette::parse(s)
-        .ok_or_else(|| format!("unknown palette `{s}` (layers, random, or a colour)"))
+        .ok_or_else(|| format!("unknown palette `{s}` (mesh, layers, random, or a colour)"))
 }
 
 fn parse_formats(s: &str) -> Result<pipeline::Formats, String> {
@@ -241,9 +241,13 @@ struct BuildArgs {
     /// ("light bluish grey"), or bl:ID for a BrickLink colour id.
     #[arg(long, conflicts_with = "palette", value_parser = parse_color)]
     color: Option<brickwright::catalog::Color>,
-    /// How to colour the pieces: layers (alternating by course), random, or one colour.
-    #[arg(long, default_value = "layers", value_parser = parse_palette)]
+    /// How to colour the pieces: mesh (the model's own colours; layers when it has none),
+    /// layers (alternating by course), random, or one colour.
+    #[arg(long, default_value = "mesh", value_parser = parse_palette)]
     palette: brickwright::catalog::Palette,
+    /// With the mesh palette, use at most N LEGO colours (the model's colours reduced in Lab).
+    #[arg(long = "colors", visible_alias = "colours", value_name = "N", value_parser = clap::value_parser!(u32).range(1..=64))]
+    colors: Option<u32>,
     /// The condition the BrickLink wanted list asks for: N (new) or U (used); default any.
     #[arg(long, value_enum)]
     condition: Option<ConditionArg>,
@@ -356,6 +360,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     opts.palette = a
         .color
         .map_or(a.palette, brickwright::catalog::Palette::Single);
+    opts.max_colors = a.colors.map(|n| n as usize);
     opts.condition = a.condition.map(|c| match c {
         ConditionArg::New => brickwright::export::partslist::Condition::New,
         ConditionArg::Used => brickwright::export::partslist::Condition::Used,
@@ -382,7 +387,13 @@ fn run_build(a: BuildArgs) -> Result<()> {
     let opts_out = opts.out_dir.clone();
     let out = pipeline::build(&opts, progress)?;
     // Warnings go to standard error, with --quiet too.
-    for w in build_warnings(&out.report) {
+    for w in out
+        .report
+        .warnings
+        .iter()
+        .cloned()
+        .chain(build_warnings(&out.report))
+    {
         eprintln!("warning: {}", escape_controls(&w));
     }
     if !a.quiet {

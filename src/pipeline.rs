@@ -31,7 +31,7 @@ use crate::grammar::{default_rules, RuleError, RuleSet};
 use crate::ldraw::{write_ldr, LdrMeta};
 use crate::mesh::{self, MeshError};
 use crate::search::{self, Repairs, SearchError, SearchOptions, SearchStats};
-use crate::voxel::{voxelize, Sizing, Up, VoxelizeError, VoxelizeOptions};
+use crate::voxel::{voxelize, Sizing, Up, VoxelColors, VoxelGrid, VoxelizeError, VoxelizeOptions};
 
 /// Everything `brickwright build` can be told.
 #[derive(Debug, Clone, Serialize)]
@@ -57,8 +57,12 @@ pub struct BuildOptions {
     pub steps: StepGrouping,
     /// Search tuning, including the seed.
     pub search: SearchOptions,
-    /// How pieces are coloured. Default [`Palette::Layers`].
+    /// How pieces are coloured. Default [`Palette::Mesh`]: the model's own
+    /// colours, or [`Palette::Layers`] for a model without any.
     pub palette: Palette,
+    /// With [`Palette::Mesh`], the most colours the build may use (the
+    /// model's colours reduced in Lab); `None` for no limit.
+    pub max_colors: Option<usize>,
     /// The condition the BrickLink wanted list asks for; `None` (the
     /// default) for any.
     pub condition: Option<Condition>,
@@ -249,6 +253,7 @@ impl BuildOptions {
             steps: StepGrouping::Auto,
             search: SearchOptions::default(),
             palette: Palette::default(),
+            max_colors: None,
             condition: None,
             formats: Formats::default(),
             template: None,
@@ -366,6 +371,20 @@ pub struct StageTimes {
 
 /// What `report.json` holds.
 #[derive(Debug, Clone, Serialize)]
+pub struct MeshColorReport {
+    /// LDraw colours the model's surface voxels take, with how many show
+    /// each, most first.
+    pub colors: Vec<(u16, usize)>,
+    /// Surface voxels of the model.
+    pub surface_voxels: usize,
+    /// Of those, how many the build shows in their own colour.
+    pub own_color: usize,
+    /// `own_color / surface_voxels`.
+    pub own_color_share: f64,
+}
+
+/// What a build did, written to `report.json`.
+#[derive(Debug, Clone, Serialize)]
 pub struct BuildReport {
     /// brickwright's version.
     pub tool_version: String,
@@ -395,6 +414,13 @@ pub struct BuildReport {
     pub quality: Quality,
     /// Pieces by part and colour, with their BrickLink and Rebrickable ids.
     pub parts: Vec<PartsRow>,
+    /// What the mesh loader could not use (a missing texture, ...), one
+    /// line each; the build went on without it.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// The model's colours, when the build is painted from them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_colors: Option<MeshColorReport>,
     /// LDraw colours of the build that have no known BrickLink or
     /// Rebrickable id (their parts-list lines say so).
     pub unmapped_colors: Vec<u16>,
@@ -548,6 +574,38 @@ pub struct BuildOutput {
     pub report: BuildReport,
 }
 
+/// How many of the model's surface voxels the build shows in their own
+/// colour: the piece covering each has that colour.
+fn mesh_color_report(assembly: &Assembly, grid: &VoxelGrid, c: &VoxelColors) -> MeshColorReport {
+    let mut shown: Vec<Option<Color>> = vec![None; grid.len()];
+    for p in &assembly.pieces {
+        for q in p.placement.body(assembly.layer_ldu).cells() {
+            if grid.in_bounds(q) {
+                shown[grid.index(q)] = Some(p.color);
+            }
+        }
+    }
+    let (mut surface, mut own) = (0, 0);
+    for (i, (&s, want)) in c.surface.iter().zip(&c.cells).enumerate() {
+        if s {
+            surface += 1;
+            if want.is_some() && shown[i] == *want {
+                own += 1;
+            }
+        }
+    }
+    MeshColorReport {
+        colors: c.used.iter().map(|&(col, n)| (col.0, n)).collect(),
+        surface_voxels: surface,
+        own_color: own,
+        own_color_share: if surface == 0 {
+            1.0
+        } else {
+            ((own as f64 / surface as f64) * 1e4).round() / 1e4
+        },
+    }
+}
+
 fn secs(t: Instant) -> f64 {
     (t.elapsed().as_secs_f64() * 1000.0).round() / 1000.0
 }
@@ -639,6 +697,13 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         file: file.clone(),
         reason,
     })?;
+    let colors = match opts.palette {
+        Palette::Mesh => crate::voxel::color_voxels(&mesh, &model, opts.up, opts.max_colors),
+        _ => None,
+    };
+    let labels = colors
+        .as_ref()
+        .map(crate::voxel::VoxelColors::surface_labels);
     times.voxelize = secs(t);
     progress.done();
 
@@ -652,6 +717,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         let guide = search::Guide {
             slant: Some(&model.slant),
             surface: Some(&model.surface),
+            colors: labels.as_deref(),
         };
         let outcome =
             search::build_guided(&model.grid, guide, &rules, &search_opts).map_err(|reason| {
@@ -664,6 +730,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         let order = search::placements(&outcome);
         let mut assembly = Assembly::from_order(&order, rules.layer_ldu(), Color::RED);
         assembly.paint(opts.palette, seed);
+        if let Some(c) = &colors {
+            assembly.paint_voxels(&model.grid, c);
+        }
         let check = verify(&assembly, Some(&outcome.voxels));
         if !check.is_ok() {
             return Err(BuildError::Unverified {
@@ -852,7 +921,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             time_budget: opts.search.time_budget.as_secs_f64(),
             slopes: opts.slopes,
             plates: opts.plates,
-            palette: opts.palette.describe(),
+            palette: match (opts.palette, &colors) {
+                (Palette::Mesh, None) => Palette::Layers.describe(),
+                (p, _) => p.describe(),
+            },
             condition: match opts.condition {
                 Some(Condition::New) => "N".into(),
                 Some(Condition::Used) => "U".into(),
@@ -885,6 +957,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             model.grid.count(),
         ),
         parts: parts.rows(),
+        warnings: mesh.warnings.clone(),
+        mesh_colors: colors
+            .as_ref()
+            .map(|c| mesh_color_report(&assembly, &model.grid, c)),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: crate::assembly::verify::components(&assembly),
         steps: assembly.step_count(),
@@ -1043,9 +1119,10 @@ fn describe(opts: &BuildOptions) -> String {
     };
     let slopes = if opts.slopes { " --slopes" } else { "" };
     let plates = if opts.plates { " --plates" } else { "" };
-    let palette = match opts.palette {
-        Palette::Layers => String::new(),
-        p => format!(" --palette {}", p.describe()),
+    let palette = match (opts.palette, opts.max_colors) {
+        (Palette::Mesh, None) => String::new(),
+        (Palette::Mesh, Some(n)) => format!(" --colors {n}"),
+        (p, _) => format!(" --palette {}", p.describe()),
     };
     let stability = match opts.stability {
         Stability::Repair => String::new(),

@@ -218,6 +218,9 @@ fixtures_build! {
     builds_open_box: "open_box.obj",
     builds_tower: "tower.glb",
     builds_wedge: "wedge.stl",
+    builds_two_tone: "two_tone.obj",
+    builds_vertex_colors: "vertex_colors.obj",
+    builds_textured: "textured.glb",
 }
 
 /// The `1` lines of an LDraw file whose part is one of `ids`.
@@ -296,7 +299,8 @@ fn every_fixture_has_a_build_test() {
     for e in std::fs::read_dir(&dir).unwrap() {
         let path = e.unwrap().path();
         let name = path.file_name().unwrap().to_str().unwrap();
-        if path.is_file() && name != "README.md" {
+        // A material library is part of its OBJ, not a model of its own.
+        if path.is_file() && name != "README.md" && !name.ends_with(".mtl") {
             assert!(
                 GOOD_FIXTURES.contains(&name),
                 "fixtures/{name} has no build test in tests/cli.rs"
@@ -888,4 +892,34 @@ fn complex_rules_are_tested_every_k_nodes_or_never() {
     let (_, off) = build_verified("box.obj", &["--complex-every", "0"]);
     assert_eq!(off["search"]["complex_tried"], 0);
     assert_eq!(off["search"]["complex_applied"], 0);
+}
+
+#[test]
+fn the_mesh_palette_is_the_default_and_colors_limits_it() {
+    let (ldr, report) = build_verified("two_tone.obj", &[]);
+    assert_eq!(report["options"]["palette"], "mesh", "{report}");
+    assert_eq!(report["mesh_colors"]["colors"].as_array().unwrap().len(), 2);
+    assert!(ldr.lines().any(|l| l.starts_with("1 4 ")), "no red piece");
+    assert!(ldr.lines().any(|l| l.starts_with("1 1 ")), "no blue piece");
+    let (ldr, report) = build_verified("two_tone.obj", &["--colors", "1"]);
+    assert_eq!(report["mesh_colors"]["colors"].as_array().unwrap().len(), 1);
+    let codes: std::collections::BTreeSet<&str> = ldr
+        .lines()
+        .filter(|l| l.starts_with("1 "))
+        .filter_map(|l| l.split_whitespace().nth(1))
+        .collect();
+    assert_eq!(codes.len(), 1, "{codes:?}");
+    let (ldr, _) = build_verified("two_tone.obj", &["--palette", "layers"]);
+    assert!(
+        ldr.lines().any(|l| l.starts_with("1 15 ")),
+        "layers paint white"
+    );
+    let tmp = tempdir();
+    let run = build(
+        tmp.path(),
+        &fixture("two_tone.obj"),
+        &tmp.path().join("o"),
+        &["--colors", "0"],
+    );
+    assert_ne!(run.code, Some(0));
 }

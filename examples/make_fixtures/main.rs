@@ -14,6 +14,7 @@
 
 mod broken;
 mod check;
+mod colored;
 mod formats;
 mod mesh;
 mod shapes;
@@ -114,6 +115,23 @@ fn run(out: &Path) -> Result<Vec<Row>, String> {
         file: "tower.glb",
         report,
     });
+
+    let (two_tone, obj, mtl) = colored::two_tone();
+    let (vc, vc_obj) = colored::vertex_colors();
+    let (tex, tex_glb) = colored::textured();
+    for (file, mesh) in [
+        ("two_tone.obj", &two_tone),
+        ("vertex_colors.obj", &vc),
+        ("textured.glb", &tex),
+    ] {
+        let report = check::check(mesh);
+        verify(file, &report, &[(192.0, 1e-6)])?;
+        rows.push(Row { file, report });
+    }
+    files.push(("two_tone.obj", obj.into_bytes()));
+    files.push(("two_tone.mtl", mtl.into_bytes()));
+    files.push(("vertex_colors.obj", vc_obj.into_bytes()));
+    files.push(("textured.glb", tex_glb));
 
     let open = broken::open_box();
     let report = check::check(&open);

@@ -15,6 +15,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::catalog::{Color, Palette, PartKind, LAYER_PALETTE, RANDOM_PALETTE};
 use crate::geom::{Body, Cell, Rot};
+use crate::voxel::{VoxelColors, VoxelGrid};
 
 /// A building step number, counted from 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -161,12 +162,57 @@ impl Assembly {
             p.color = match palette {
                 Palette::Single(c) => c,
                 Palette::Random => RANDOM_PALETTE[rng.gen_range(0..RANDOM_PALETTE.len())],
-                Palette::Layers => {
+                Palette::Layers | Palette::Mesh => {
                     // By brick course (24 LDU), whatever the layer height.
                     let course = (p.placement.origin.z * layer_ldu).div_euclid(24);
                     LAYER_PALETTE[course.rem_euclid(LAYER_PALETTE.len() as i32) as usize]
                 }
             };
+        }
+    }
+
+    /// Colours every piece from the voxel colours `colors` (cells indexed
+    /// as in `grid`): the colour most of the surface voxels it covers show,
+    /// else most of its voxels, else that of the nearest coloured voxel
+    /// (a piece filling only cells outside the model).
+    pub fn paint_voxels(&mut self, grid: &VoxelGrid, colors: &VoxelColors) {
+        let layer_ldu = self.layer_ldu;
+        for p in &mut self.pieces {
+            let body = p.placement.body(layer_ldu);
+            let cells: Vec<Cell> = body.cells().filter(|&c| grid.in_bounds(c)).collect();
+            let vote = |surface_only: bool| {
+                let mut n: std::collections::BTreeMap<Color, usize> = Default::default();
+                for &c in &cells {
+                    let i = grid.index(c);
+                    if let Some(col) =
+                        colors.cells[i].filter(|_| !surface_only || colors.surface[i])
+                    {
+                        *n.entry(col).or_default() += 1;
+                    }
+                }
+                n.into_iter()
+                    .max_by_key(|&(c, k)| (k, std::cmp::Reverse(c)))
+                    .map(|(c, _)| c)
+            };
+            let near = || {
+                (1..=4).find_map(|r| {
+                    body.cells().find_map(|c| {
+                        (-r..=r).find_map(|dz| {
+                            (-r..=r).find_map(|dy| {
+                                (-r..=r).find_map(|dx| {
+                                    let n = c.offset(dx, dy, dz);
+                                    grid.in_bounds(n)
+                                        .then(|| colors.cells[grid.index(n)])
+                                        .flatten()
+                                })
+                            })
+                        })
+                    })
+                })
+            };
+            if let Some(c) = vote(true).or_else(|| vote(false)).or_else(near) {
+                p.color = c;
+            }
         }
     }
 

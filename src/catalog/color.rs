@@ -209,17 +209,23 @@ pub enum Palette {
     /// seed (the paper's photographs used random colours).
     Random,
     /// Alternating colours by brick course ([`LAYER_PALETTE`]), so the
-    /// bond between courses reads (the default).
-    #[default]
+    /// bond between courses reads (what [`Palette::Mesh`] falls back to for
+    /// an uncoloured model).
     Layers,
+    /// The model's own colours (materials, textures, vertex colours), each
+    /// matched to the nearest catalog colour; for a model without colours,
+    /// [`Palette::Layers`] (the default).
+    #[default]
+    Mesh,
 }
 
 impl Palette {
-    /// `layers`, `random`, or one colour as [`Color::parse`] reads it.
+    /// `mesh`, `layers`, `random`, or one colour as [`Color::parse`] reads it.
     pub fn parse(s: &str) -> Option<Palette> {
         match s.trim().to_ascii_lowercase().as_str() {
             "layers" => Some(Palette::Layers),
             "random" => Some(Palette::Random),
+            "mesh" => Some(Palette::Mesh),
             _ => Color::parse(s).map(Palette::Single),
         }
     }
@@ -230,6 +236,7 @@ impl Palette {
             Palette::Single(c) => format!("{}", c.0),
             Palette::Random => "random".into(),
             Palette::Layers => "layers".into(),
+            Palette::Mesh => "mesh".into(),
         }
     }
 }

@@ -82,6 +82,12 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let buffers: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
 
     let mut raw = Mesh::default();
+    raw.paint = Some(super::gltf_paint::materials(
+        &document,
+        &buffers,
+        path,
+        &mut raw.warnings,
+    ));
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next());
@@ -188,8 +194,13 @@ fn add_mesh(
             Mode::TriangleFan => Box::new((1..n.saturating_sub(1)).map(|i| [0, i, i + 1])),
             _ => Box::new((0..n / 3).map(|i| [3 * i, 3 * i + 1, 3 * i + 2])),
         };
+        let tris: Vec<[u32; 3]> = tris.map(|t| t.map(|k| indices[k])).collect();
+        if let Some(paint) = out.paint.as_mut() {
+            let faces = super::gltf_paint::faces(&prim, buffers, &tris).map_err(|e| here(&e))?;
+            paint.faces.extend(faces);
+        }
         out.triangles
-            .extend(tris.map(|t| t.map(|k| indices[k] + base)));
+            .extend(tris.iter().map(|t| t.map(|i| i + base)));
         out.positions.extend(positions);
         if out.triangles.len() > MAX_TRIANGLES {
             return Err(format!(
@@ -202,7 +213,7 @@ fn add_mesh(
 
 /// Calls `f` with the `size` bytes of each element of `acc`, checking every
 /// offset against the buffer view and buffer.
-fn for_each_element(
+pub(super) fn for_each_element(
     acc: &::gltf::Accessor<'_>,
     buffers: &[&[u8]],
     size: usize,

@@ -32,21 +32,40 @@
 
 mod buffers;
 mod gltf;
+mod gltf_paint;
 mod obj;
+pub mod paint;
 mod stl;
+
+pub use paint::{FacePaint, Material, Paint, Texture, Wrap};
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-/// A triangle mesh: positions and triangles indexing them.
+/// A triangle mesh: positions and triangles indexing them, and the
+/// surface's colours when the file has any.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
     /// Vertex positions in the file's units and axes.
     pub positions: Vec<Vec3>,
     /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
+    /// The surface's colours, one [`FacePaint`] per triangle; `None` when
+    /// the file has none (STL, or an OBJ or glTF without materials or
+    /// vertex colours).
+    pub paint: Option<Paint>,
+    /// What the loader could not use but built on anyway, one line each
+    /// (e.g. a missing texture file, its material's colour standing in).
+    pub warnings: Vec<String>,
+}
+
+impl Mesh {
+    /// Whether the mesh carries colours of its own.
+    pub fn has_color(&self) -> bool {
+        self.paint.as_ref().is_some_and(Paint::has_color)
+    }
 }
 
 /// The largest extent along any axis, in file units, that [`load`] accepts.
@@ -252,8 +271,12 @@ pub(crate) fn finish(path: &Path, raw: Mesh) -> Result<Mesh, MeshError> {
         }
     }
     let mut remap = vec![u32::MAX; count];
-    let mut mesh = Mesh::default();
-    for t in &raw.triangles {
+    let mut mesh = Mesh {
+        warnings: raw.warnings.clone(),
+        ..Mesh::default()
+    };
+    let mut faces = Vec::new();
+    for (k, t) in raw.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| raw.positions[i as usize]);
         if a == b || b == c || a == c || (b - a).cross(c - a) == Vec3::ZERO {
             continue;
@@ -267,6 +290,12 @@ pub(crate) fn finish(path: &Path, raw: Mesh) -> Result<Mesh, MeshError> {
             *slot
         });
         mesh.triangles.push(tri);
+        if let Some(p) = &raw.paint {
+            faces.push(p.faces.get(k).copied().unwrap_or_default());
+        }
+    }
+    if let Some(p) = raw.paint {
+        mesh.paint = Some(Paint { faces, ..p }).filter(Paint::has_color);
     }
     if mesh.triangles.is_empty() {
         let detail = if total > 0 {
@@ -381,6 +410,7 @@ mod tests {
                 Vec3::X * 2.0,
             ],
             triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 4]],
+            ..Mesh::default()
         };
         let m = finish(p, raw).unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
@@ -393,6 +423,7 @@ mod tests {
         let tri = |a: Vec3, b: Vec3, c: Vec3| Mesh {
             positions: vec![a, b, c],
             triangles: vec![[0, 1, 2]],
+            ..Mesh::default()
         };
         let e = finish(p, tri(Vec3::ZERO, Vec3::X, Vec3::Y * 2e7)).unwrap_err();
         assert!(matches!(e, MeshError::TooLarge { .. }), "{e}");

@@ -12,7 +12,66 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::{finish, Location, Mesh, MeshError};
+use super::paint::{srgb_to_linear, Texture};
+use super::{finish, FacePaint, Location, Material, Mesh, MeshError, Paint};
+
+/// The largest material library or texture file read, in bytes.
+const MAX_SIDE_FILE: u64 = 256 << 20;
+
+/// Reads a side file (material library or texture), refusing huge ones.
+fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
+    let meta = std::fs::metadata(path).map_err(|_| "is missing".to_string())?;
+    if meta.len() > MAX_SIDE_FILE {
+        return Err(format!("is larger than {} MB", MAX_SIDE_FILE >> 20));
+    }
+    std::fs::read(path).map_err(|e| format!("cannot be read ({e})"))
+}
+
+/// The OBJ's materials as [`Material`]s: `Kd` (sRGB) as the base colour and
+/// `map_Kd` decoded from the OBJ's folder. A texture that is missing or
+/// cannot be decoded is a warning naming it, and `Kd` stands in.
+fn obj_materials(
+    path: &Path,
+    folder: &Path,
+    mats: &[tobj::Material],
+    warnings: &mut Vec<String>,
+) -> Paint {
+    let mut paint = Paint::default();
+    for m in mats {
+        let kd = m.diffuse.unwrap_or([1.0; 3]);
+        let mut texture = None;
+        if let Some(name) = m
+            .diffuse_texture
+            .as_deref()
+            .filter(|n| !n.trim().is_empty())
+        {
+            // `map_Kd -opt ... file`: the file is the last word.
+            let file = name.split_whitespace().last().unwrap_or(name);
+            let loaded = super::paint::inside_folder(folder, file)
+                .ok_or_else(|| "is outside the model's folder".to_string())
+                .and_then(|p| read_bounded(&p))
+                .and_then(|b| Texture::decode(&b).map_err(|e| format!("cannot be decoded ({e})")));
+            match loaded {
+                Ok(t) => {
+                    texture = Some(paint.textures.len());
+                    paint.textures.push(t);
+                }
+                Err(why) => warnings.push(format!(
+                    "{}: texture {file:?} of material {:?} {why}; its Kd colour stands in",
+                    path.display(),
+                    m.name
+                )),
+            }
+        }
+        paint.materials.push(Material {
+            name: m.name.clone(),
+            color: kd.map(|c| srgb_to_linear(c.clamp(0.0, 1.0))),
+            texture,
+            flip_v: true,
+        });
+    }
+    paint
+}
 
 /// Parses the OBJ text in `bytes` (read from `path`, used in messages).
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
@@ -23,15 +82,47 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    // Materials are irrelevant here; never open .mtl files.
-    let (models, _materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
+    // Material libraries are read only from the OBJ's own folder; one that
+    // is missing or unreadable is a warning, and its faces go uncoloured.
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let warnings = std::cell::RefCell::new(Vec::new());
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |name| {
+        let shown = name.display().to_string();
+        let bytes = super::paint::inside_folder(folder, &shown)
+            .ok_or_else(|| "is outside the model's folder".to_string())
+            .and_then(|p| read_bounded(&p));
+        match bytes {
+            Ok(b) => tobj::load_mtl_buf(&mut b.as_slice()).or_else(|e| {
+                warnings.borrow_mut().push(format!(
+                    "{}: material library {shown:?} is not valid ({e}); its materials are ignored",
+                    path.display()
+                ));
+                Ok(Default::default())
+            }),
+            Err(why) => {
+                warnings.borrow_mut().push(format!(
+                    "{}: material library {shown:?} {why}; its materials are ignored",
+                    path.display()
+                ));
+                Ok(Default::default())
+            }
+        }
     })
     .map_err(|e| MeshError::Malformed {
         at: Location::file(path),
         reason: format!("not a valid OBJ file ({e}); re-export it"),
     })?;
-    let mut raw = Mesh::default();
+    let mut raw = Mesh {
+        warnings: warnings.into_inner(),
+        ..Mesh::default()
+    };
+    let paint = obj_materials(
+        path,
+        folder,
+        &materials.unwrap_or_default(),
+        &mut raw.warnings,
+    );
+    let mut faces = Vec::new();
     for model in &models {
         let m = &model.mesh;
         let base = raw.positions.len() as u32;
@@ -45,7 +136,39 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 .chunks_exact(3)
                 .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
         );
+        let material = m
+            .material_id
+            .filter(|&i| i < paint.materials.len())
+            .map(|i| i as u32);
+        let has_uv = m.texcoord_indices.len() == m.indices.len() && !m.texcoords.is_empty();
+        let has_vc = m.vertex_color.len() == m.positions.len() && !m.vertex_color.is_empty();
+        for (k, c) in m.indices.chunks_exact(3).enumerate() {
+            let uv = has_uv
+                .then(|| {
+                    let t = &m.texcoord_indices[3 * k..3 * k + 3];
+                    let get = |i: u32| {
+                        let i = i as usize * 2;
+                        Some([*m.texcoords.get(i)?, *m.texcoords.get(i + 1)?])
+                    };
+                    Some([get(t[0])?, get(t[1])?, get(t[2])?])
+                })
+                .flatten();
+            let color = has_vc.then(|| {
+                [c[0], c[1], c[2]].map(|i| {
+                    let i = i as usize * 3;
+                    [0, 1, 2].map(|j| {
+                        super::paint::srgb_to_linear(m.vertex_color[i + j].clamp(0.0, 1.0))
+                    })
+                })
+            });
+            faces.push(FacePaint {
+                material,
+                uv,
+                color,
+            });
+        }
     }
+    raw.paint = Some(Paint { faces, ..paint });
     finish(path, raw)
 }
 
@@ -327,5 +450,65 @@ mod tests {
             let f = write("m.obj", &b);
             let _ = load(&f.path);
         }
+    }
+}
+
+#[cfg(test)]
+mod colour_tests {
+    use super::super::load;
+
+    /// A quad with texture coordinates, its MTL naming a 2 x 2 PNG (top
+    /// row red, bottom row blue) beside it; and a vertex-coloured triangle.
+    #[test]
+    fn map_kd_textures_and_vertex_colours() {
+        let dir = tempfile::tempdir().unwrap();
+        let img = image::RgbImage::from_fn(2, 2, |_, y| {
+            image::Rgb(if y == 0 { [255, 0, 0] } else { [0, 0, 255] })
+        });
+        img.save(dir.path().join("tex.png")).unwrap();
+        std::fs::write(
+            dir.path().join("m.mtl"),
+            "newmtl t\nKd 1 1 1\nmap_Kd tex.png\n",
+        )
+        .unwrap();
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                   vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+        let path = dir.path().join("q.obj");
+        std::fs::write(&path, obj).unwrap();
+        let m = load(&path).unwrap();
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        let p = m.paint.as_ref().unwrap();
+        // OBJ's v counts up: v = 0 is the image's bottom row (blue).
+        assert_eq!(p.sample(0, [0.9, 0.05, 0.05]), [0.0, 0.0, 1.0]);
+        assert_eq!(p.sample(1, [0.05, 0.05, 0.9]), [1.0, 0.0, 0.0]);
+
+        let path = dir.path().join("vc.obj");
+        std::fs::write(
+            &path,
+            "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let m = load(&path).unwrap();
+        let p = m.paint.as_ref().unwrap();
+        assert_eq!(p.sample(0, [1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]);
+        assert_eq!(p.sample(0, [0.0, 0.0, 1.0]), [0.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn a_material_library_outside_the_folder_is_not_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.obj");
+        std::fs::write(
+            &path,
+            "mtllib ../secret.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let m = load(&path).unwrap();
+        assert!(m.paint.is_none());
+        assert!(
+            m.warnings.len() == 1 && m.warnings[0].contains("outside"),
+            "{:?}",
+            m.warnings
+        );
     }
 }

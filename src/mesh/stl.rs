@@ -60,6 +60,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             .iter()
             .map(|f| f.vertices.map(|i| i as u32))
             .collect(),
+        ..Mesh::default()
     };
     finish(path, raw)
 }

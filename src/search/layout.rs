@@ -220,6 +220,10 @@ pub(crate) struct Layout<'a> {
     /// Empty cells the surface passes through.
     pub near: VoxelGrid,
     pub slant: Option<&'a Slant>,
+    /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
+    /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
+    /// only, so colour boundaries fall between pieces.
+    pub colors: Option<&'a [u16]>,
     pub shapes: Vec<PieceShape>,
     pub weights: Weights,
     /// The piece owning each cell, or [`NONE`].
@@ -235,6 +239,12 @@ pub(crate) struct Layout<'a> {
     /// The score of the layer being laid so far.
     layer_score: f64,
 }
+
+/// A piece may show a second colour on at most one surface voxel in this
+/// many of its own colour: a speck of another colour does not cut a big
+/// piece in two, and the surface still shows its own colour almost
+/// everywhere.
+const COLOR_SLACK: usize = 5;
 
 /// Layers of more separate patches than this are laid as a whole.
 const MAX_REGIONS: usize = 1024;
@@ -307,6 +317,7 @@ impl<'a> Layout<'a> {
             must,
             near,
             slant,
+            colors: None,
             shapes: shapes(rules),
             weights: Weights::default(),
             owner: vec![NONE; must.len()],
@@ -574,7 +585,8 @@ impl<'a> Layout<'a> {
 
     /// Whether the piece `body` fits: every cell free and allowed by
     /// `reach`, a slope's open face clear of the model and of pieces and
-    /// slanting the way the mesh does. Returns how many cells it fills of
+    /// slanting the way the mesh does, and on the visible surface of one
+    /// colour (see [`Layout::colors`]). Returns how many cells it fills of
     /// the model's voxels, of the cells the surface passes through, and of
     /// other empty cells.
     pub(super) fn fits(
@@ -584,10 +596,22 @@ impl<'a> Layout<'a> {
         reach: Reach,
     ) -> Option<(usize, usize, usize)> {
         let (mut inside, mut outside, mut far) = (0, 0, 0);
+        // Surface voxels by colour: at most two colours, the other one at
+        // most one voxel in every `COLOR_SLACK` of the main one.
+        let mut labels: [(u16, usize); 2] = [(0, 0); 2];
         for b in body.boxes() {
             for q in b.cells() {
                 if !self.free(q) {
                     return None;
+                }
+                if let Some(colors) = self.colors {
+                    let l = colors.get(self.must.index(q)).copied().unwrap_or(0);
+                    if l != 0 {
+                        match labels.iter_mut().find(|(k, _)| *k == l || *k == 0) {
+                            Some(slot) => *slot = (l, slot.1 + 1),
+                            None => return None,
+                        }
+                    }
                 }
                 if self.must.get(q) {
                     inside += 1;
@@ -597,6 +621,10 @@ impl<'a> Layout<'a> {
                     far += 1;
                 }
             }
+        }
+        let (a, b) = (labels[0].1, labels[1].1);
+        if a.min(b) > 0 && a.min(b) * COLOR_SLACK > a.max(b) {
+            return None;
         }
         if far > 0 && reach == Reach::Near {
             return None;

@@ -210,6 +210,10 @@ pub struct Guide<'a> {
     /// the voxels to join a thin feature (without it, any empty cell
     /// touching a voxel).
     pub surface: Option<&'a VoxelGrid>,
+    /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label,
+    /// 0 for none. No piece covers surface voxels of two labels, so pieces
+    /// split where the model's colours change (inner pieces may span them).
+    pub colors: Option<&'a [u16]>,
 }
 
 /// Finds an ordered, connected build of `voxels` with the rules `rules`;
@@ -255,6 +259,7 @@ pub fn build_guided(
 
     let mut layout = layout::Layout::new(rules, &fixed, guide.surface, guide.slant);
     layout.repairs = repairs;
+    layout.colors = guide.colors.filter(|c| c.len() == fixed.len());
     let mut dice = Dice::new(opts.seed);
     layout.lay(opts, &mut dice, deadline);
     layout.join(&mut dice.rules);

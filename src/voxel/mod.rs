@@ -9,3 +9,5 @@ pub use grid::VoxelGrid;
 pub use voxelize::{
     to_grid_frame, voxelize, Sizing, Slant, Up, VoxelModel, VoxelizeError, VoxelizeOptions,
 };
+pub mod colour;
+pub use colour::{color_voxels, VoxelColors};

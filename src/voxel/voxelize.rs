@@ -61,7 +61,7 @@
 //!     [0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
 //!     [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5],
 //! ];
-//! let mesh = Mesh { positions, triangles };
+//! let mesh = Mesh { positions, triangles, ..Mesh::default() };
 //! let opts = VoxelizeOptions::default()
 //!     .with_sizing(Sizing::Studs(10))
 //!     .with_up(Up::Z);
@@ -971,6 +971,7 @@ mod tests {
         let flat = Mesh {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             triangles: vec![[0, 1, 2]],
+            ..Mesh::default()
         };
         let e = voxelize(&flat, &z_up(Sizing::Height(3))).unwrap_err();
         assert!(matches!(e, VoxelizeError::Flat { .. }), "{e}");
