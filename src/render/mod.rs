@@ -106,6 +106,7 @@ mod scene;
 mod steps;
 mod stress;
 mod turn;
+mod zoom;
 
 use std::path::{Path, PathBuf};
 
@@ -280,6 +281,10 @@ pub struct RenderOptions {
     /// hides (`view` stays the base view, and the finished model is
     /// always seen from it). Default [`Turning::Auto`].
     pub turn: Turning,
+    /// Whether each step's picture is framed to the model as built so far
+    /// (zooming out in a few stages as it grows) rather than to the
+    /// finished model. Default true.
+    pub zoom: bool,
 }
 
 impl Default for RenderOptions {
@@ -295,6 +300,7 @@ impl Default for RenderOptions {
             background: Background::White,
             highlight: Highlight::Strong,
             turn: Turning::Auto,
+            zoom: true,
         }
     }
 }
@@ -363,6 +369,11 @@ impl RenderOptions {
     /// With this choice of turning the view.
     pub fn with_turn(self, turn: Turning) -> Self {
         RenderOptions { turn, ..self }
+    }
+
+    /// With or without framing each step to the model built so far.
+    pub fn with_zoom(self, zoom: bool) -> Self {
+        RenderOptions { zoom, ..self }
     }
 
     /// Checks every option's range.
