@@ -68,7 +68,10 @@ fn framing(fixture: &str, studs: u32) -> (BuildOutput, Framing) {
     let badge = (opts.width.min(opts.height) as f32 * 0.15).round() as u32 + 24;
     let mut shares = Vec::new();
     for n in 0..built.report.steps as usize {
-        let path = tmp.path().join("steps").join(format!("step-{:03}.png", n + 1));
+        let path = tmp
+            .path()
+            .join("steps")
+            .join(format!("step-{:03}.png", n + 1));
         let img = image::open(&path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
             .to_rgb8();

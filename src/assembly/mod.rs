@@ -94,7 +94,10 @@ impl Assembly {
     /// Regroups the steps. `Auto` (the default) makes a step of each run
     /// of pieces on one brick course, a big run split into balanced steps
     /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep
-    /// within [`MAX_STEPS`]; `Each` one piece a step; `Size(n)` n pieces a
+    /// within [`MAX_STEPS`]; a run of fewer than [`STEP_MIN_PIECES`] (a
+    /// piece that hangs from the course above comes after it, between two
+    /// runs) joins the smaller of its neighbours when the two fit in one
+    /// step; `Each` one piece a step; `Size(n)` n pieces a
     /// step; `Layer` one step per course run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
         let layer_ldu = self.layer_ldu;
@@ -129,10 +132,10 @@ impl Assembly {
                         .collect()
                 };
                 let mut cap = STEP_PIECES;
-                let mut sizes = split(cap);
+                let mut sizes = merge_small(split(cap), cap);
                 while sizes.len() > MAX_STEPS && cap < self.pieces.len() {
                     cap += 1;
-                    sizes = split(cap);
+                    sizes = merge_small(split(cap), cap);
                 }
                 if sizes.len() > MAX_STEPS {
                     // More course runs than LeoCAD shows: merge runs.
@@ -184,6 +187,44 @@ impl Assembly {
 /// what to add (a course with more is split into several steps).
 pub const STEP_PIECES: usize = 8;
 
+/// New pieces a step holds at least where the model allows: smaller runs
+/// join a neighbouring step (see [`Assembly::regroup`]).
+pub const STEP_MIN_PIECES: usize = 3;
+
+/// Joins each group of fewer than [`STEP_MIN_PIECES`] to the smaller of
+/// its neighbours (the one before on a tie) when the two hold at most
+/// `cap` pieces, until none can join; the order of pieces is unchanged.
+fn merge_small(mut sizes: Vec<usize>, cap: usize) -> Vec<usize> {
+    loop {
+        let mut changed = false;
+        let mut i = 0;
+        while i < sizes.len() {
+            if sizes[i] >= STEP_MIN_PIECES {
+                i += 1;
+                continue;
+            }
+            let before = (i > 0).then(|| sizes[i - 1] + sizes[i]);
+            let after = sizes.get(i + 1).map(|n| n + sizes[i]);
+            match (before.filter(|&n| n <= cap), after.filter(|&n| n <= cap)) {
+                (Some(b), a) if a.is_none_or(|a| b <= a) => {
+                    sizes[i - 1] = b;
+                    sizes.remove(i);
+                    changed = true;
+                }
+                (_, Some(a)) => {
+                    sizes[i] = a;
+                    sizes.remove(i + 1);
+                    changed = true;
+                }
+                _ => i += 1,
+            }
+        }
+        if !changed {
+            return sizes;
+        }
+    }
+}
+
 /// Steps LeoCAD shows at most (its step counter is one byte); a model with
 /// more steps loads, but its later steps are missing from the view.
 pub const MAX_STEPS: usize = 255;
@@ -217,10 +258,11 @@ mod tests {
 
     #[test]
     fn auto_steps_stay_within_what_leocad_shows() {
-        // Three pieces a course: a step a course.
+        // Three pieces a course: a step a course, the last course's two
+        // pieces joining the step before.
         let mut small = assembly(200);
         small.regroup(StepGrouping::Auto);
-        assert_eq!(small.step_count(), 67);
+        assert_eq!(small.step_count(), 66);
         // 1000 courses would be 334 steps: runs are merged to stay in 255.
         let mut big = assembly(1000);
         big.regroup(StepGrouping::Auto);
@@ -235,6 +277,16 @@ mod tests {
         let mut each = assembly(9);
         each.regroup(StepGrouping::Each);
         assert_eq!(each.step_count(), 9);
+    }
+
+    #[test]
+    fn small_runs_join_a_neighbouring_step() {
+        assert_eq!(merge_small(vec![5, 1, 1, 6], 8), vec![7, 6]);
+        assert_eq!(merge_small(vec![1, 1, 1, 1], 8), vec![4]);
+        assert_eq!(merge_small(vec![8, 1, 8], 8), vec![8, 1, 8]);
+        assert_eq!(merge_small(vec![2, 7], 8), vec![2, 7]);
+        assert_eq!(merge_small(vec![4, 2, 3], 8), vec![4, 5]);
+        assert!(merge_small(Vec::new(), 8).is_empty());
     }
 
     #[test]
