@@ -95,7 +95,7 @@ fn framing(fixture: &str, studs: u32) -> (BuildOutput, Framing) {
             let (a, b) = (r.step_camera(n - 1).scale(), r.step_camera(n).scale());
             let change = (a - b).abs() / a.max(b);
             assert!(
-                change < 1e-4 || change >= 0.25 - 1e-4,
+                !(1e-4..0.25 - 1e-4).contains(&change),
                 "{fixture}: the scale changes by {change:.3} at step {}",
                 n + 1
             );
