@@ -11,9 +11,12 @@
 //!
 //! 1. **Scene.** Every piece becomes triangles in LDraw world coordinates
 //!    (LDU, -Y up), each piece with its colour and step ([`Scene`]).
-//! 2. **Camera.** One orthographic [`Camera`] is fitted to the finished
-//!    model and shared by every image of it, so step images line up
-//!    ([`View`] sets azimuth, elevation and quarter turns). A step whose
+//! 2. **Camera.** An orthographic [`Camera`] is fitted to the finished
+//!    model ([`View`] sets azimuth, elevation and quarter turns). Step
+//!    images are framed to the model as built so far: runs of steps share
+//!    one camera, fitted to what is built by the run's end, and the scale
+//!    changes rarely, a quarter or more at a time
+//!    ([`RenderOptions::zoom`]). A step whose
 //!    new pieces that view hides is seen from it turned by quarter turns
 //!    about the vertical axis, at the same scale, and its image shows a
 //!    "turn the model" arrow ([`Turning`]; the view stays put over runs
@@ -136,8 +139,8 @@ pub const MAX_SAMPLES: u64 = 64 << 20;
 /// Side in pixels of [`part_image`]'s square pictures.
 pub const PART_IMAGE_SIZE: u32 = 128;
 
-/// A step renderer for `assembly`, its camera fitted to the finished
-/// model: every image it draws shares one projection and scale.
+/// A step renderer for `assembly`, its base camera fitted to the finished
+/// model, its step images framed as [`StepRenderer::new`] says.
 pub fn renderer(assembly: &Assembly, opts: &RenderOptions) -> Result<StepRenderer, RenderError> {
     StepRenderer::new(Scene::from_assembly(assembly), opts)
 }
