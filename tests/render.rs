@@ -164,7 +164,7 @@ fn every_step_of_a_real_build_has_an_image_that_adds_only_its_pieces() {
     let mut opts =
         BuildOptions::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj"));
     opts.out_dir = build_dir.path().to_path_buf();
-    opts.sizing = Sizing::Studs(8);
+    opts.sizing = Sizing::Studs(10);
     let asm = pipeline::build(&opts, &Silent).unwrap().assembly;
     let steps = asm.step_count() as usize;
     assert!(steps > 5);
@@ -184,12 +184,13 @@ fn every_step_of_a_real_build_has_an_image_that_adds_only_its_pieces() {
     }
 
     // The unfaded layer: a step changes pixels only near its own pieces
-    // (unless the view turned to show them).
+    // (unless the view turned to show them, or zoomed out).
     let plain = ropts.with_highlight(Highlight::None);
     let r = render::renderer(&asm, &plain).unwrap();
     let imgs: Vec<RgbaImage> = r.images().map(|(_, i)| i).collect();
     for n in 1..imgs.len() {
-        if r.turn_at(n).is_some() {
+        // A step seen turned or zoomed is drawn anew.
+        if r.turn_at(n).is_some() || r.step_camera(n) != r.step_camera(n - 1) {
             continue;
         }
         let zone = r.step_rect(n).grown(2, 200, 150);
@@ -215,7 +216,8 @@ fn every_step_of_a_real_build_has_an_image_that_adds_only_its_pieces() {
         assert!(r.step_image(n).unwrap() == imgs[n], "step {}", n + 1);
     }
     for n in 1..imgs.len() {
-        if r.turn_at(n).is_some() {
+        // A step seen turned or zoomed is drawn anew.
+        if r.turn_at(n).is_some() || r.step_camera(n) != r.step_camera(n - 1) {
             continue;
         }
         let new = r.step_rect(n).grown(2, 200, 150);

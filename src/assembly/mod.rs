@@ -95,7 +95,10 @@ impl Assembly {
     /// Regroups the steps. `Auto` (the default) makes a step of each run
     /// of pieces on one brick course, a big run split into balanced steps
     /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep
-    /// within [`MAX_STEPS`]; `Each` one piece a step; `Size(n)` n pieces a
+    /// within [`MAX_STEPS`]; a run of fewer than [`STEP_MIN_PIECES`] (a
+    /// piece that hangs from the course above comes after it, between two
+    /// runs) joins the smaller of its neighbours when the two fit in one
+    /// step; `Each` one piece a step; `Size(n)` n pieces a
     /// step; `Layer` one step per course run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
         let layer_ldu = self.layer_ldu;
@@ -120,6 +123,7 @@ impl Assembly {
             }
             StepGrouping::Layer => runs,
             StepGrouping::Auto => {
+                let courses: Vec<i32> = self.pieces.iter().map(course).collect();
                 let split = |cap: usize| -> Vec<usize> {
                     runs.iter()
                         .flat_map(|&n| {
@@ -130,10 +134,10 @@ impl Assembly {
                         .collect()
                 };
                 let mut cap = STEP_PIECES;
-                let mut sizes = split(cap);
+                let mut sizes = merge_small(split(cap), cap, &courses);
                 while sizes.len() > MAX_STEPS && cap < self.pieces.len() {
                     cap += 1;
-                    sizes = split(cap);
+                    sizes = merge_small(split(cap), cap, &courses);
                 }
                 if sizes.len() > MAX_STEPS {
                     // More course runs than LeoCAD shows: merge runs.
@@ -230,6 +234,69 @@ impl Assembly {
 /// what to add (a course with more is split into several steps).
 pub const STEP_PIECES: usize = 8;
 
+/// New pieces a step holds at least where the model allows: smaller runs
+/// join a neighbouring step (see [`Assembly::regroup`]).
+pub const STEP_MIN_PIECES: usize = 3;
+
+/// Joins each group of fewer than [`STEP_MIN_PIECES`] to the smaller of
+/// its neighbours (the one before on a tie) when the two hold at most
+/// `cap` pieces on at most two neighbouring courses (`courses[i]` is
+/// piece `i`'s), until none can join; the order of pieces is unchanged.
+fn merge_small(mut sizes: Vec<usize>, cap: usize, courses: &[i32]) -> Vec<usize> {
+    // Each group's lowest and highest course.
+    let mut span: Vec<(i32, i32)> = Vec::with_capacity(sizes.len());
+    let mut at = 0;
+    for &n in &sizes {
+        let c = &courses[at..at + n];
+        span.push((
+            c.iter().copied().min().unwrap_or(0),
+            c.iter().copied().max().unwrap_or(0),
+        ));
+        at += n;
+    }
+    let joined = |a: (i32, i32), b: (i32, i32)| (a.0.min(b.0), a.1.max(b.1));
+    let fits = |a: (i32, i32), b: (i32, i32), n: usize| {
+        let (lo, hi) = joined(a, b);
+        n <= cap && hi - lo <= 1
+    };
+    loop {
+        let mut changed = false;
+        let mut i = 0;
+        while i < sizes.len() {
+            if sizes[i] >= STEP_MIN_PIECES {
+                i += 1;
+                continue;
+            }
+            let before = (i > 0)
+                .then(|| sizes[i - 1] + sizes[i])
+                .filter(|&n| fits(span[i - 1], span[i], n));
+            let after = (i + 1 < sizes.len())
+                .then(|| sizes[i + 1] + sizes[i])
+                .filter(|&n| fits(span[i + 1], span[i], n));
+            match (before, after) {
+                (Some(b), a) if a.is_none_or(|a| b <= a) => {
+                    sizes[i - 1] = b;
+                    span[i - 1] = joined(span[i - 1], span[i]);
+                    sizes.remove(i);
+                    span.remove(i);
+                    changed = true;
+                }
+                (_, Some(a)) => {
+                    sizes[i] = a;
+                    span[i] = joined(span[i], span[i + 1]);
+                    sizes.remove(i + 1);
+                    span.remove(i + 1);
+                    changed = true;
+                }
+                _ => i += 1,
+            }
+        }
+        if !changed {
+            return sizes;
+        }
+    }
+}
+
 /// Steps LeoCAD shows at most (its step counter is one byte); a model with
 /// more steps loads, but its later steps are missing from the view.
 pub const MAX_STEPS: usize = 255;
@@ -263,10 +330,11 @@ mod tests {
 
     #[test]
     fn auto_steps_stay_within_what_leocad_shows() {
-        // Three pieces a course: a step a course.
+        // Three pieces a course: a step a course, the last course's two
+        // pieces joining the step before.
         let mut small = assembly(200);
         small.regroup(StepGrouping::Auto);
-        assert_eq!(small.step_count(), 67);
+        assert_eq!(small.step_count(), 66);
         // 1000 courses would be 334 steps: runs are merged to stay in 255.
         let mut big = assembly(1000);
         big.regroup(StepGrouping::Auto);
@@ -281,6 +349,29 @@ mod tests {
         let mut each = assembly(9);
         each.regroup(StepGrouping::Each);
         assert_eq!(each.step_count(), 9);
+    }
+
+    #[test]
+    fn small_runs_join_a_neighbouring_step() {
+        // Piece courses of groups of the given sizes and courses.
+        let courses = |groups: &[(usize, i32)]| -> (Vec<usize>, Vec<i32>) {
+            let sizes = groups.iter().map(|g| g.0).collect();
+            let c = groups.iter().flat_map(|&(n, c)| vec![c; n]).collect();
+            (sizes, c)
+        };
+        let m = |groups: &[(usize, i32)]| {
+            let (sizes, c) = courses(groups);
+            merge_small(sizes, 8, &c)
+        };
+        assert_eq!(m(&[(5, 0), (1, 1), (1, 0), (6, 1)]), vec![7, 6]);
+        assert_eq!(m(&[(1, 0), (1, 1), (1, 0), (1, 1)]), vec![4]);
+        assert_eq!(m(&[(8, 0), (1, 1), (8, 2)]), vec![8, 1, 8]);
+        assert_eq!(m(&[(2, 0), (7, 1)]), vec![2, 7]);
+        assert_eq!(m(&[(4, 0), (2, 1), (3, 2)]), vec![4, 5]);
+        // A step spans at most two neighbouring courses.
+        assert_eq!(m(&[(4, 0), (1, 2), (3, 4)]), vec![4, 1, 3]);
+        assert_eq!(m(&[(1, 0), (1, 1), (1, 2)]), vec![2, 1]);
+        assert!(m(&[]).is_empty());
     }
 
     #[test]

@@ -127,21 +127,28 @@ impl Camera {
         height: u32,
         margin: u32,
     ) -> Camera {
-        let unit = Camera::new(view, Vec3::ZERO, 1.0, width, height);
-        let mut lo = Vec2::splat(f32::INFINITY);
-        let mut hi = Vec2::splat(f32::NEG_INFINITY);
-        let mut lo_depth = f32::INFINITY;
-        let mut hi_depth = f32::NEG_INFINITY;
+        let mut bounds = Bounds::EMPTY;
         for p in points {
-            let q = Vec3::new(p.dot(unit.right), p.dot(unit.down), p.dot(unit.forward));
-            if !q.is_finite() {
-                continue;
-            }
-            lo = lo.min(q.truncate());
-            hi = hi.max(q.truncate());
-            lo_depth = lo_depth.min(q.z);
-            hi_depth = hi_depth.max(q.z);
+            bounds.add(view, p);
         }
+        Camera::fit_bounds(view, &bounds, width, height, margin)
+    }
+
+    /// [`Camera::fit`] to points whose extent in `view` is `bounds`.
+    pub(crate) fn fit_bounds(
+        view: &View,
+        bounds: &Bounds,
+        width: u32,
+        height: u32,
+        margin: u32,
+    ) -> Camera {
+        let unit = Camera::new(view, Vec3::ZERO, 1.0, width, height);
+        let Bounds {
+            lo,
+            hi,
+            lo_depth,
+            hi_depth,
+        } = *bounds;
         if !lo.is_finite() || !hi.is_finite() {
             return unit;
         }
@@ -223,6 +230,58 @@ impl Camera {
     /// Image height in pixels.
     pub fn height(&self) -> u32 {
         self.height
+    }
+}
+
+/// The extent of some points as a view sees them: along its screen axes
+/// (LDU, at one pixel per LDU) and in depth. Bounds of parts of a model
+/// unite into the bounds of the whole, so a camera can be fitted to any
+/// prefix of the building steps without visiting its points again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Bounds {
+    lo: Vec2,
+    hi: Vec2,
+    lo_depth: f32,
+    hi_depth: f32,
+}
+
+impl Bounds {
+    /// No points.
+    pub(crate) const EMPTY: Bounds = Bounds {
+        lo: Vec2::splat(f32::INFINITY),
+        hi: Vec2::splat(f32::NEG_INFINITY),
+        lo_depth: f32::INFINITY,
+        hi_depth: f32::NEG_INFINITY,
+    };
+
+    /// Grows the bounds to hold `p` as `view` sees it; a point that is
+    /// not finite is left out.
+    pub(crate) fn add(&mut self, view: &View, p: Vec3) {
+        let forward = -view.toward_eye();
+        let right = forward.cross(UP).try_normalize().unwrap_or(Vec3::X);
+        let down = forward.cross(right);
+        self.add_on_axes(right, down, forward, p);
+    }
+
+    /// Grows the bounds to hold every one of `points` as `view` sees them.
+    pub(crate) fn extend(&mut self, view: &View, points: impl IntoIterator<Item = Vec3>) {
+        let forward = -view.toward_eye();
+        let right = forward.cross(UP).try_normalize().unwrap_or(Vec3::X);
+        let down = forward.cross(right);
+        for p in points {
+            self.add_on_axes(right, down, forward, p);
+        }
+    }
+
+    fn add_on_axes(&mut self, right: Vec3, down: Vec3, forward: Vec3, p: Vec3) {
+        let q = Vec3::new(p.dot(right), p.dot(down), p.dot(forward));
+        if !q.is_finite() {
+            return;
+        }
+        self.lo = self.lo.min(q.truncate());
+        self.hi = self.hi.max(q.truncate());
+        self.lo_depth = self.lo_depth.min(q.z);
+        self.hi_depth = self.hi_depth.max(q.z);
     }
 }
 

@@ -11,9 +11,12 @@
 //!
 //! 1. **Scene.** Every piece becomes triangles in LDraw world coordinates
 //!    (LDU, -Y up), each piece with its colour and step ([`Scene`]).
-//! 2. **Camera.** One orthographic [`Camera`] is fitted to the finished
-//!    model and shared by every image of it, so step images line up
-//!    ([`View`] sets azimuth, elevation and quarter turns). A step whose
+//! 2. **Camera.** An orthographic [`Camera`] is fitted to the finished
+//!    model ([`View`] sets azimuth, elevation and quarter turns). Step
+//!    images are framed to the model as built so far: runs of steps share
+//!    one camera, fitted to what is built by the run's end, and the scale
+//!    changes rarely, a quarter or more at a time
+//!    ([`RenderOptions::zoom`]). A step whose
 //!    new pieces that view hides is seen from it turned by quarter turns
 //!    about the vertical axis, at the same scale, and its image shows a
 //!    "turn the model" arrow ([`Turning`]; the view stays put over runs
@@ -106,6 +109,7 @@ mod scene;
 mod steps;
 mod stress;
 mod turn;
+mod zoom;
 
 use std::path::{Path, PathBuf};
 
@@ -135,8 +139,8 @@ pub const MAX_SAMPLES: u64 = 64 << 20;
 /// Side in pixels of [`part_image`]'s square pictures.
 pub const PART_IMAGE_SIZE: u32 = 128;
 
-/// A step renderer for `assembly`, its camera fitted to the finished
-/// model: every image it draws shares one projection and scale.
+/// A step renderer for `assembly`, its base camera fitted to the finished
+/// model, its step images framed as [`StepRenderer::new`] says.
 pub fn renderer(assembly: &Assembly, opts: &RenderOptions) -> Result<StepRenderer, RenderError> {
     StepRenderer::new(Scene::from_assembly(assembly), opts)
 }
@@ -280,6 +284,10 @@ pub struct RenderOptions {
     /// hides (`view` stays the base view, and the finished model is
     /// always seen from it). Default [`Turning::Auto`].
     pub turn: Turning,
+    /// Whether each step's picture is framed to the model as built so far
+    /// (zooming out in a few stages as it grows) rather than to the
+    /// finished model. Default true.
+    pub zoom: bool,
 }
 
 impl Default for RenderOptions {
@@ -295,6 +303,7 @@ impl Default for RenderOptions {
             background: Background::White,
             highlight: Highlight::Strong,
             turn: Turning::Auto,
+            zoom: true,
         }
     }
 }
@@ -363,6 +372,11 @@ impl RenderOptions {
     /// With this choice of turning the view.
     pub fn with_turn(self, turn: Turning) -> Self {
         RenderOptions { turn, ..self }
+    }
+
+    /// With or without framing each step to the model built so far.
+    pub fn with_zoom(self, zoom: bool) -> Self {
+        RenderOptions { zoom, ..self }
     }
 
     /// Checks every option's range.

@@ -34,6 +34,8 @@ use super::marks::draw_turn;
 use super::raster::{piece_rect, Light, PixelRect, Samples};
 use super::scene::Scene;
 use super::turn::{self, Turning};
+use super::zoom;
+use super::View;
 use super::{Background, Highlight, RenderError, RenderOptions};
 use crate::assembly::Step;
 use crate::fsutil::write_atomic;
@@ -63,10 +65,13 @@ impl Eye {
 #[derive(Debug, Clone)]
 pub struct StepRenderer {
     scene: Scene,
-    /// The base view turned by 0 (always there), 1, 2 and 3 quarter turns.
+    /// The base view fitted to the finished model (always first), then
+    /// the other views the steps are seen through.
     eyes: Vec<Eye>,
-    /// Each step's view, an index of `eyes`.
+    /// Each step's view: quarter turns from the base view.
     step_turns: Vec<u8>,
+    /// Each step's eye, an index of `eyes`.
+    step_eye: Vec<usize>,
     style: Style,
     supersample: u32,
     /// Piece indices ordered by step (stable).
@@ -82,12 +87,18 @@ pub struct StepRenderer {
 }
 
 impl StepRenderer {
-    /// A renderer for `scene`, its camera fitted once to the whole scene.
+    /// A renderer for `scene`, its base camera fitted to the whole scene
+    /// (the finished model's picture).
     ///
     /// With [`Turning::Auto`] (the default), the steps whose new pieces
     /// the view hides are seen from the base view turned (see
-    /// [`Turning`]); if any is, every view is fitted to the whole scene and
-    /// all share the smallest of their scales, so pieces keep their size.
+    /// [`Turning`]); the turned views share the base view's scale, so
+    /// pieces keep their size when the view turns.
+    ///
+    /// With [`RenderOptions::zoom`] (the default), each step's picture is
+    /// framed to the model as built so far, zooming out in a few stages as
+    /// it grows (see the `zoom` module docs); otherwise every step is seen
+    /// at the finished model's scale.
     pub fn new(scene: Scene, opts: &RenderOptions) -> Result<StepRenderer, RenderError> {
         opts.validate()?;
         let camera = Camera::fit(
@@ -108,7 +119,44 @@ impl StepRenderer {
                 r.step_turns = turns;
             }
         }
+        r.step_eye = r.step_turns.iter().map(|&t| usize::from(t)).collect();
+        if opts.zoom && r.steps.len() > 1 {
+            r.zoom(opts);
+        }
         Ok(r)
+    }
+
+    /// Frames each step to the model built so far (see [`zoom`]).
+    fn zoom(&mut self, opts: &RenderOptions) {
+        let views: Vec<View> = if self.eyes.len() > 1 {
+            (0..4).map(|k| opts.view.turned(k)).collect()
+        } else {
+            vec![opts.view]
+        };
+        let framing = zoom::frame(
+            &self.scene,
+            &self.order,
+            &self.steps,
+            &views,
+            (opts.width, opts.height, opts.margin),
+        );
+        let mut made: Vec<((usize, u8), usize)> = Vec::new();
+        for (j, (range, _)) in framing.stages.iter().enumerate() {
+            for n in range.clone() {
+                let t = self.step_turns[n];
+                let key = (j, t);
+                let idx = match made.iter().find(|(k, _)| *k == key) {
+                    Some(&(_, idx)) => idx,
+                    None => {
+                        let cam = framing.cameras[j][usize::from(t).min(views.len() - 1)];
+                        self.eyes.push(Eye::new(&self.scene, cam));
+                        made.push((key, self.eyes.len() - 1));
+                        self.eyes.len() - 1
+                    }
+                };
+                self.step_eye[n] = idx;
+            }
+        }
     }
 
     /// A renderer for `scene` seen through `camera` (whose size wins over
@@ -131,6 +179,7 @@ impl StepRenderer {
         StepRenderer {
             eyes: vec![Eye::new(&scene, camera)],
             step_turns: vec![0; steps.len()],
+            step_eye: vec![0; steps.len()],
             scene,
             style,
             supersample: ss,
@@ -142,8 +191,9 @@ impl StepRenderer {
         }
     }
 
-    /// The camera of the base view: of the finished model and of every
-    /// step not turned.
+    /// The camera of the base view, fitted to the finished model: of the
+    /// finished model's picture, and of every step neither turned nor
+    /// zoomed.
     pub fn camera(&self) -> &Camera {
         &self.eyes[0].camera
     }
@@ -172,9 +222,15 @@ impl StepRenderer {
         (n < self.steps.len() && turns != 0).then_some(turns)
     }
 
+    /// The eye (an index of `eyes`) of step number `n`; the base eye past
+    /// the last step.
+    fn step_eye(&self, n: usize) -> usize {
+        self.step_eye.get(n).copied().unwrap_or(0)
+    }
+
     /// The view of step number `n`.
     fn eye(&self, n: usize) -> &Eye {
-        &self.eyes[usize::from(self.step_turns(n)).min(self.eyes.len() - 1)]
+        &self.eyes[self.step_eye(n).min(self.eyes.len() - 1)]
     }
 
     /// The scene being drawn.
@@ -329,7 +385,7 @@ impl StepRenderer {
         let mut runs = Vec::new();
         let mut start = 0;
         for end in 1..=n {
-            if end == n || end - start == per_run || self.turn_at(end).is_some() {
+            if end == n || end - start == per_run || self.step_eye(end) != self.step_eye(end - 1) {
                 runs.push(start..end);
                 start = end;
             }
@@ -396,8 +452,8 @@ pub fn write_png(img: &RgbaImage, alpha: bool, w: &mut dyn Write) -> io::Result<
 #[derive(Debug)]
 pub struct StepImages<'a> {
     renderer: Cow<'a, StepRenderer>,
-    /// The samples so far, and the view (quarter turns) they were drawn in.
-    samples: Option<(Samples, u8)>,
+    /// The samples so far, and the eye they were drawn through.
+    samples: Option<(Samples, usize)>,
     image: RgbaImage,
     next: usize,
     end: usize,
@@ -426,7 +482,7 @@ impl Iterator for StepImages<'_> {
         let r = &*self.renderer;
         let n = self.next;
         let looks = r.looks(n);
-        let turns = r.step_turns(n);
+        let turns = r.step_eye(n);
         let eye = r.eye(n);
         match &mut self.samples {
             Some((samples, t)) if *t == turns => {

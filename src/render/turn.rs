@@ -10,7 +10,10 @@
 //! 1. **Four cameras, one scale.** The base view turned by 0, 1, 2 and 3
 //!    quarter turns about the vertical axis, each fitted to the finished
 //!    model, then all given the smallest of the four scales
-//!    ([`turned_cameras`]): a piece is the same size in every view.
+//!    ([`turned_cameras`]): a piece is the same size in every view. (The
+//!    step images are then zoomed to the model built so far, each run of
+//!    steps at one scale in all four views; how well a view shows a step
+//!    does not depend on the zoom.)
 //! 2. **How well each view shows each step.** Every view draws the model
 //!    step by step into a small probe depth buffer (320 pixels across, one
 //!    sample a pixel), each piece as its bounding box. For each new piece,
