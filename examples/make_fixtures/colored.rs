@@ -142,7 +142,7 @@ pub fn textured() -> (Mesh, Vec<u8>) {
             bin.extend((i as u16).to_le_bytes());
         }
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let png_at = bin.len();
