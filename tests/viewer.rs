@@ -40,6 +40,11 @@ fn build_page(fixture: &str, studs: u32, out: &Path) -> (PathBuf, u32) {
 /// Headless Chromium on `url` with `args` added; its standard output and
 /// the page's console lines (from its log on standard error).
 fn chromium(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
+    // A profile of its own each run: a browser still closing keeps its
+    // profile locked.
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let profile = profile.join(format!("run-{run}"));
     let out = Command::new("chromium")
         .args([
             "--headless",

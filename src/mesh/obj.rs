@@ -198,10 +198,14 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
     let total = logical_lines(text)
         .filter(|(_, l)| l.split_whitespace().next() == Some("v"))
         .count();
+    let total_vt = logical_lines(text)
+        .filter(|(_, l)| l.split_whitespace().next() == Some("vt"))
+        .count();
     let mut seen = 0usize;
+    let mut seen_vt = 0usize;
     // The text handed on: comments gone, continued lines joined, and face
-    // corners cut to their vertex index (`tobj` multiplies texture and
-    // normal indices unchecked, and the mesh needs neither).
+    // corners cut to their vertex and texture indices, both checked
+    // (`tobj` multiplies indices unchecked, and the mesh needs no normals).
     let mut out = String::with_capacity(text.len());
     for (no, line) in logical_lines(text) {
         if line.contains('\0') {
@@ -234,6 +238,7 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
                     }
                 }
             }
+            Some("vt") => seen_vt += 1,
             Some("f") => {
                 let corners: Vec<&str> = words.collect();
                 if corners.len() < 3 {
@@ -242,9 +247,13 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
                         format!("face has {} corners, needs at least 3", corners.len()),
                     ));
                 }
+                let face_start = out.len();
+                let mut corner_v: Vec<&str> = Vec::with_capacity(corners.len());
+                let mut corner_vt: Vec<Option<&str>> = Vec::with_capacity(corners.len());
                 out.push('f');
                 for c in corners {
                     let first = c.split('/').next().unwrap_or("");
+                    corner_v.push(first);
                     let Ok(i) = first.parse::<i64>() else {
                         return Err(bad(no, format!("face corner {c:?} is not a vertex index")));
                     };
@@ -265,6 +274,30 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
                     }
                     out.push(' ');
                     out.push_str(first);
+                    corner_vt.push(c.split('/').nth(1).filter(|t| !t.is_empty()));
+                }
+                // Texture indices, when every corner has a valid one: a
+                // face whose are missing or out of range is read without
+                // (a sloppy exporter's, or a hostile file's).
+                let valid = |t: &str| {
+                    t.parse::<i64>().is_ok_and(|k| {
+                        if k > 0 {
+                            k as u64 <= total_vt as u64
+                        } else {
+                            k < 0 && k.unsigned_abs() <= seen_vt as u64
+                        }
+                    })
+                };
+                if corner_vt.iter().all(|t| t.is_some_and(valid)) {
+                    let mut with = String::from("f");
+                    for (v, t) in corner_v.iter().zip(&corner_vt) {
+                        with.push(' ');
+                        with.push_str(v);
+                        with.push('/');
+                        with.push_str(t.unwrap_or_default());
+                    }
+                    out.truncate(face_start);
+                    out.push_str(&with);
                 }
                 out.push('\n');
                 continue;
