@@ -77,8 +77,30 @@ fn the_booklet_has_every_step_and_part() {
         let bom = pages_text[1];
         assert!(bom.contains("Parts list"));
         let all = text.as_str();
+        // Each parts-list cell reads, top to bottom: "<count>x", the name,
+        // the colour, "LDraw <part> / <colour>", "BrickLink ...". Find each
+        // row's LDraw line and read the count three lines above it, in the
+        // same column.
+        let lines: Vec<&str> = text.lines().collect();
+        let mut counted = std::collections::BTreeMap::new();
+        for (i, line) in lines.iter().enumerate().skip(3) {
+            for (col, _) in line.match_indices("LDraw ") {
+                let cell: Vec<&str> = line[col..].split_whitespace().take(4).collect();
+                let above = lines[i - 3].get(col..).unwrap_or("");
+                if let ([_, part, "/", code], Some(count)) =
+                    (cell.as_slice(), above.split_whitespace().next())
+                {
+                    counted.insert((part.to_string(), code.to_string()), count.to_string());
+                }
+            }
+        }
         for row in &report.parts {
-            assert!(all.contains(&format!("{}x", row.count)), "count of {row:?}");
+            let key = (row.part.clone(), row.color.to_string());
+            assert_eq!(
+                counted.get(&key).map(String::as_str),
+                Some(format!("{}x", row.count).as_str()),
+                "count of {row:?} in the parts list"
+            );
             assert!(all.contains(&row.name), "{}", row.name);
             assert!(
                 all.contains(&format!("BrickLink {}", row.bricklink)),
