@@ -244,24 +244,13 @@ impl Slant {
                 }
             }
             // Sample the triangle every half cell or finer.
-            let span = (t[1] - t[0])
-                .length()
-                .max((t[2] - t[0]).length())
-                .max((t[2] - t[1]).length());
-            let steps = (span * 2.0).ceil().clamp(1.0, 4096.0) as usize;
-            for i in 0..=steps {
-                for j in 0..=(steps - i) {
-                    let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
-                    let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
-                    let c = Cell::new(p.x.floor() as i32, p.y.floor() as i32, p.z.floor() as i32);
-                    if !grids[0].in_bounds(c) {
-                        continue;
-                    }
+            sample_cells(t, 2.0, |c| {
+                if grids[0].in_bounds(c) {
                     for &k in &dirs {
                         grids[k].set(c, true);
                     }
                 }
-            }
+            });
         }
         out
     }
@@ -407,26 +396,38 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
     })
 }
 
+/// Calls `f` with the cell of every sample of the triangle `t` (in cell
+/// units), taken on a grid of `per_cell` samples a cell along its longest
+/// side (at most 4,096 along it); a cell may come more than once.
+fn sample_cells(t: &[DVec3; 3], per_cell: f64, mut f: impl FnMut(Cell)) {
+    let span = (t[1] - t[0])
+        .length()
+        .max((t[2] - t[0]).length())
+        .max((t[2] - t[1]).length());
+    let steps = (span * per_cell).ceil().clamp(1.0, 4096.0) as usize;
+    for i in 0..=steps {
+        for j in 0..=(steps - i) {
+            let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
+            let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+            f(Cell::new(
+                p.x.floor() as i32,
+                p.y.floor() as i32,
+                p.z.floor() as i32,
+            ));
+        }
+    }
+}
+
 /// The cells the triangles (in cell units) pass through, sampled every
 /// third of a cell or finer.
 fn surface_cells(tris: &[[DVec3; 3]], dims: (i32, i32, i32)) -> VoxelGrid {
     let mut out = VoxelGrid::new(dims.0, dims.1, dims.2);
     for t in tris {
-        let span = (t[1] - t[0])
-            .length()
-            .max((t[2] - t[0]).length())
-            .max((t[2] - t[1]).length());
-        let steps = (span * 3.0).ceil().clamp(1.0, 4096.0) as usize;
-        for i in 0..=steps {
-            for j in 0..=(steps - i) {
-                let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
-                let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
-                let c = Cell::new(p.x.floor() as i32, p.y.floor() as i32, p.z.floor() as i32);
-                if out.in_bounds(c) {
-                    out.set(c, true);
-                }
+        sample_cells(t, 3.0, |c| {
+            if out.in_bounds(c) {
+                out.set(c, true);
             }
-        }
+        });
     }
     out
 }
