@@ -28,6 +28,7 @@ mod complex;
 mod derive;
 mod join;
 mod layout;
+mod merge;
 mod prepare;
 mod rulebook;
 
@@ -103,6 +104,8 @@ pub struct SearchStats {
     pub widened: u64,
     /// Local repairs that joined a loose body to the rest.
     pub joins: u64,
+    /// Pairs of neighbouring pieces merged into one bigger piece.
+    pub merges: u64,
     /// Pieces laid in a gap under a piece that could not be put in place
     /// otherwise.
     pub fills: u64,
@@ -263,6 +266,7 @@ pub fn build_guided(
     let mut dice = Dice::new(opts.seed);
     layout.lay(opts, &mut dice, deadline);
     layout.join(&mut dice.rules);
+    layout.merge();
     let (mut order, mut unreached) = derive::derive(&layout);
     // A piece pressed on from below with pieces under it, too close to
     // slide out of the way, cannot be put in place: fill the gap under it
