@@ -2,7 +2,7 @@
 //! a rule of the Lego rewriting system (paper, sections 3 and 4).
 //!
 //! [`build`] takes the voxels and a [`RuleSet`] and returns the pieces in
-//! build order, in four stages, one module each:
+//! build order, in four stages:
 //!
 //! 1. `prepare`: islands are joined to the body (a support column or the
 //!    shortest bridge, never dropped), one-layer sheets thickened, flat tops
@@ -16,6 +16,8 @@
 //! 3. `join`: local repair instead of backtracking: a body of pieces that
 //!    rests on nothing the rules join is joined to another by growing one of
 //!    its pieces or laying a piece across, with the fewest cells outside;
+//!    `merge` then makes neighbours whose union is a piece of the alphabet
+//!    one piece: never a seam more, always a piece fewer;
 //! 4. `derive`: the pieces ordered as a derivation: a starting rule, then
 //!    each piece added by the heaviest rule joining it to a piece already
 //!    there, lowest course first.
