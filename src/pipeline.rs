@@ -477,7 +477,6 @@ impl Quality {
         rep: &Repairs,
         seams: crate::assembly::metrics::SeamStats,
         sizing: Sizing,
-        input_voxels: usize,
     ) -> Quality {
         let n = asm.pieces.len().max(1);
         let singles = asm
@@ -497,7 +496,6 @@ impl Quality {
             );
         }
         let round = |x: f64, k: f64| (x * k).round() / k;
-        let _ = input_voxels;
         Quality {
             left_out: rep.left_out + rep.budget_left_out,
             left_out_places: rep.left_out_places.clone(),
@@ -949,13 +947,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             ((voxels as f64 / own.max(1) as f64) * 100.0).round() / 100.0
         },
         seams,
-        quality: Quality::of(
-            &assembly,
-            &outcome.repairs,
-            seams,
-            opts.sizing,
-            model.grid.count(),
-        ),
+        quality: Quality::of(&assembly, &outcome.repairs, seams, opts.sizing),
         parts: parts.rows(),
         warnings: mesh.warnings.clone(),
         mesh_colors: colors

@@ -257,7 +257,6 @@ fn shortest_bridge(
     joined: &VoxelGrid,
     all: &VoxelGrid,
 ) -> Option<(usize, Vec<Cell>)> {
-    let (nx, ny, nz) = all.dims();
     let mut island_of = vec![u32::MAX; all.len()];
     for (k, island) in pending.iter().enumerate() {
         for &c in island.iter() {
@@ -270,7 +269,6 @@ fn shortest_bridge(
         from[all.index(c)] = all.index(c) as u32;
         queue.push_back(c);
     }
-    let _ = (nx, ny, nz);
     while let Some(c) = queue.pop_front() {
         for n in neighbors6(c) {
             if !all.in_bounds(n) || from[all.index(n)] != u32::MAX {
