@@ -296,6 +296,47 @@ fn weak_pixels(
     Ok(Some([counts[0], counts[1], counts[2], counts[3]]))
 }
 
+impl<'a> Pictures<'a> {
+    /// The pictures of a settled build named `title`.
+    pub(super) fn of(
+        settled: &'a super::stability::Settled,
+        title: &'a str,
+        layer_ldu: i32,
+    ) -> Self {
+        let (nx, ny, nz) = settled.outcome.voxels.dims();
+        Pictures {
+            assembly: &settled.assembly,
+            title,
+            size_studs: [
+                f64::from(nx),
+                f64::from(ny),
+                f64::from(nz * layer_ldu) / 24.0,
+            ],
+            size_cm: size_cm(settled.outcome.voxels.dims(), layer_ldu),
+            step_notes: settled.step_notes(),
+        }
+    }
+}
+
+/// The size of a model of `nx` by `ny` studs and `nz` layers of
+/// `layer_ldu`, in centimetres (x, y, height).
+pub(super) fn size_cm((nx, ny, nz): (i32, i32, i32), layer_ldu: i32) -> [f64; 3] {
+    [
+        f64::from(nx) * 0.8,
+        f64::from(ny) * 0.8,
+        (f64::from(nz * layer_ldu) * 0.04 * 100.0).round() / 100.0,
+    ]
+}
+
+/// Whether any of `formats` is a picture (step images and the booklet need
+/// the steps drawn; the model and exploded views do not).
+pub(super) fn wanted(formats: &super::Formats) -> Option<bool> {
+    use super::Format;
+    let steps = formats.contains(Format::Steps) || formats.contains(Format::Pdf);
+    (steps || formats.contains(Format::Png) || formats.contains(Format::ExplodedPng))
+        .then_some(steps)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -693,3 +693,71 @@ impl From<PhysicsError> for crate::pipeline::BuildError {
         crate::pipeline::BuildError::Physics(e)
     }
 }
+
+/// A build after the stability stage: the plan to write and, unless the
+/// stage was off, its report and the finished model's analysis.
+pub(super) struct Settled {
+    pub outcome: SearchOutcome,
+    pub assembly: Assembly,
+    /// The order's name, for the report.
+    pub order: &'static str,
+    pub stability: Option<(StabilityReport, Analysis)>,
+}
+
+impl Settled {
+    /// `plan` as it is, with `--stability off`.
+    pub(super) fn unchecked((outcome, assembly, order): Plan) -> Self {
+        Settled {
+            outcome,
+            assembly,
+            order,
+            stability: None,
+        }
+    }
+
+    /// What the booklet and the `.ldr` say of a step that adds a support
+    /// column.
+    pub(super) fn step_notes(&self) -> std::collections::BTreeMap<u32, String> {
+        self.stability
+            .iter()
+            .flat_map(|(r, _)| &r.supports)
+            .map(|c| (c.step, crate::pipeline::SUPPORT_NOTE.to_string()))
+            .collect()
+    }
+
+    /// Pieces of support columns (they fill no voxel of the model).
+    pub(super) fn support_pieces(&self) -> usize {
+        self.stability.as_ref().map_or(0, |(r, _)| r.support_pieces)
+    }
+}
+
+/// The stage: checks, and with [`Stability::Repair`] repairs, the first
+/// plan, asking `planner` for other layouts when the repair needs them.
+/// With [`Stability::Check`], a step that would not stand is an error.
+pub(super) fn stage(
+    opts: &crate::pipeline::BuildOptions,
+    first: Plan,
+    planner: &super::plan::Planner<'_>,
+) -> Result<Settled, crate::pipeline::BuildError> {
+    let ((outcome, assembly, order), report, finished) = settle(
+        opts.stability,
+        first,
+        opts.search.seed,
+        &Params::default(),
+        opts.stability_budget,
+        opts.supports,
+        &|seed| planner.plan(seed),
+    )?;
+    if opts.stability == Stability::Check && report.first_failure.is_some() {
+        return Err(crate::pipeline::BuildError::Unstable {
+            file: opts.input.display().to_string(),
+            reason: report.failure.clone().unwrap_or_default(),
+        });
+    }
+    Ok(Settled {
+        outcome,
+        assembly,
+        order,
+        stability: Some((report, finished)),
+    })
+}

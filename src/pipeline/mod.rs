@@ -1,0 +1,144 @@
+//! The whole job: mesh file in, verified LDraw build and report out.
+//!
+//! [`build`] runs the stages in order, each a function with its own input
+//! and output: [`load`](input::load) the mesh,
+//! [`voxelize`](input::voxelize) it, [`layout`](plan::Planner::layout)
+//! the pieces, [`order`](plan::Planner::order) them into verified steps,
+//! check and repair their [`stability`], draw the [`pictures`] and the
+//! booklet, and [`write`](write::write) every output. The assembly is
+//! verified with the independent [`verify`](crate::assembly::verify)
+//! before anything is written, and every output is written atomically: a
+//! failed run leaves no file behind.
+
+use std::time::Instant;
+
+mod error;
+mod input;
+mod options;
+pub mod pictures;
+mod plan;
+mod report;
+pub mod stability;
+mod write;
+
+pub use error::BuildError;
+pub use input::load_rules;
+pub use options::{BuildOptions, Format, Formats, DEFAULT_STABILITY_BUDGET, SUPPORT_NOTE};
+pub use report::{BuildReport, MeshColorReport, Quality, ReportOptions, StageTimes};
+pub use stability::{Stability, StabilityReport};
+
+use crate::assembly::Assembly;
+
+/// Stage callbacks, for progress display.
+pub trait Progress {
+    /// A stage starts.
+    fn stage(&self, name: &str);
+    /// The current stage ended.
+    fn done(&self);
+    /// `done` of the current stage's `total` items are finished (step
+    /// images drawn, say), for a display with counts and time left. By
+    /// default nothing.
+    fn advance(&self, done: u64, total: u64) {
+        let _ = (done, total);
+    }
+}
+
+/// No progress display.
+pub struct Silent;
+
+impl Progress for Silent {
+    fn stage(&self, _: &str) {}
+    fn done(&self) {}
+}
+
+/// The build and what happened.
+#[derive(Debug, Clone)]
+pub struct BuildOutput {
+    /// The verified assembly, steps grouped.
+    pub assembly: Assembly,
+    /// The report written to `report.json`.
+    pub report: BuildReport,
+}
+
+/// Seconds since `t`, to the millisecond.
+fn secs(t: Instant) -> f64 {
+    (t.elapsed().as_secs_f64() * 1000.0).round() / 1000.0
+}
+
+/// Runs `f` as the stage `name`: shown by `progress`, its time added to
+/// `time`.
+fn stage<T>(
+    progress: &dyn Progress,
+    name: &str,
+    time: &mut f64,
+    f: impl FnOnce() -> Result<T, BuildError>,
+) -> Result<T, BuildError> {
+    progress.stage(name);
+    let t = Instant::now();
+    let out = f();
+    *time += secs(t);
+    progress.done();
+    out
+}
+
+/// Runs the pipeline and writes the outputs `opts.formats` names and
+/// `report.json` into `opts.out_dir`.
+pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput, BuildError> {
+    opts.check()?;
+    let mut times = StageTimes::default();
+    // Rules first: a bad rule file should fail before any slow work.
+    let setup = stage(&Silent, "", &mut times.rules, || input::setup(opts))?;
+    let mesh = stage(progress, "loading mesh", &mut times.load, || {
+        input::load(opts)
+    })?;
+    let model = stage(progress, "voxelizing", &mut times.voxelize, || {
+        input::voxelize(opts, &mesh, &setup.rules)
+    })?;
+
+    let planner = plan::Planner::new(opts, &model, &setup.rules, progress);
+    let mut search_time = 0.0;
+    let first = stage(progress, "searching", &mut search_time, || planner.first())?;
+    times.verify = planner.verify_secs();
+    times.search = search_time - times.verify;
+
+    let settled = match opts.stability {
+        Stability::Off => stability::Settled::unchecked(first),
+        _ => stage(progress, "checking stability", &mut times.stability, || {
+            stability::stage(opts, first, &planner)
+        })?,
+    };
+
+    let stem = opts.stem();
+    let pictures = pictures::Pictures::of(&settled, &stem, setup.rules.layer_ldu());
+    let rendered = match pictures::wanted(&opts.formats) {
+        Some(steps) => Some(stage(progress, "rendering", &mut times.render, || {
+            Ok(pictures::render_all(&pictures, steps, progress)?)
+        })?),
+        None => None,
+    };
+    let booklet = match &rendered {
+        Some(rendered) if opts.formats.contains(Format::Pdf) => Some(stage(
+            progress,
+            "laying out the booklet",
+            &mut times.booklet,
+            || write::booklet(opts, &pictures, rendered, &setup.template),
+        )?),
+        _ => None,
+    };
+
+    let report = report::compose(opts, &mesh, &model, &setup, &settled, times);
+    progress.stage("writing");
+    let report = write::write(
+        opts,
+        &settled,
+        &pictures,
+        rendered.as_ref(),
+        booklet.as_deref(),
+        report,
+    )?;
+    progress.done();
+    Ok(BuildOutput {
+        assembly: settled.assembly,
+        report,
+    })
+}

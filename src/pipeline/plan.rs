@@ -1,0 +1,142 @@
+//! The layout and order stages: the search lays the pieces, the verifier
+//! checks them, and they are put in steps a builder can follow.
+
+use std::cell::Cell;
+use std::time::Instant;
+
+use super::error::cover_error;
+use super::input::Voxels;
+use super::stability::Plan;
+use super::{secs, BuildError, BuildOptions, Progress};
+use crate::assembly::order::by_course;
+use crate::assembly::verify::verify;
+use crate::assembly::Assembly;
+use crate::catalog::Color;
+use crate::grammar::RuleSet;
+use crate::search::{self, SearchOutcome};
+
+/// Plans builds of one model: the first with the options' seed, and
+/// others with other seeds when the stability repair asks for them.
+pub(super) struct Planner<'a> {
+    opts: &'a BuildOptions,
+    voxels: &'a Voxels,
+    rules: &'a RuleSet,
+    progress: &'a dyn Progress,
+    file: String,
+    /// Time spent verifying, across plans.
+    verify_secs: Cell<f64>,
+}
+
+impl<'a> Planner<'a> {
+    pub(super) fn new(
+        opts: &'a BuildOptions,
+        voxels: &'a Voxels,
+        rules: &'a RuleSet,
+        progress: &'a dyn Progress,
+    ) -> Self {
+        Planner {
+            opts,
+            voxels,
+            rules,
+            progress,
+            file: opts.input.display().to_string(),
+            verify_secs: Cell::new(0.0),
+        }
+    }
+
+    /// Seconds spent verifying so far (part of every plan's time).
+    pub(super) fn verify_secs(&self) -> f64 {
+        self.verify_secs.get()
+    }
+
+    /// The plan with the options' own seed. A rule file that cannot cover
+    /// the shape is an error naming what it lacks, not a build of a
+    /// fragment; with `--strict`, so is any voxel left out.
+    pub(super) fn first(&self) -> Result<Plan, BuildError> {
+        let (rules, opts) = (self.rules, self.opts);
+        let first = self.plan(opts.search.seed).map_err(|e| match e {
+            BuildError::Search { .. } => cover_error(rules, opts, None).unwrap_or(e),
+            e => e,
+        })?;
+        let rep = &first.0.repairs;
+        if rep.left_out > 0 {
+            if let Some(e) = cover_error(rules, opts, Some(rep.left_out)) {
+                return Err(e);
+            }
+        }
+        if opts.strict {
+            if let Some(p) = rep.left_out_places.first() {
+                return Err(BuildError::LeftOut {
+                    file: self.file.clone(),
+                    voxels: rep.left_out + rep.budget_left_out,
+                    layer: p.layer,
+                    x: p.x,
+                    y: p.y,
+                    reason: p.reason.clone(),
+                });
+            }
+        }
+        Ok(first)
+    }
+
+    /// A verified, grouped build from the layout with `seed`.
+    pub(super) fn plan(&self, seed: u64) -> Result<Plan, BuildError> {
+        let (outcome, assembly) = self.layout(seed)?;
+        let t = Instant::now();
+        let (assembly, order) = self.order(&outcome, assembly)?;
+        self.verify_secs.set(self.verify_secs.get() + secs(t));
+        Ok((outcome, assembly, order))
+    }
+
+    /// The search's pieces for `seed`, painted.
+    pub(super) fn layout(&self, seed: u64) -> Result<(SearchOutcome, Assembly), BuildError> {
+        let opts = self.opts;
+        let model = &self.voxels.model;
+        let guide = search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+            colors: self.voxels.labels.as_deref(),
+        };
+        let search_opts = opts.search.clone().with_seed(seed);
+        let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
+            |reason| BuildError::Search {
+                file: self.file.clone(),
+                reason,
+            },
+        )?;
+        let _ = self.progress;
+        let order = search::placements(&outcome);
+        let mut assembly = Assembly::from_order(&order, self.rules.layer_ldu(), Color::RED);
+        assembly.paint(opts.palette, seed);
+        if let Some(c) = &self.voxels.colors {
+            assembly.paint_voxels(&model.grid, c);
+        }
+        Ok((outcome, assembly))
+    }
+
+    /// `assembly` verified against the voxels `outcome` built, then
+    /// re-sequenced course by course so steps read like instructions (the
+    /// search's order is kept if the re-sequenced one does not verify),
+    /// and grouped in steps. Also the order's name, for the report.
+    pub(super) fn order(
+        &self,
+        outcome: &SearchOutcome,
+        assembly: Assembly,
+    ) -> Result<(Assembly, &'static str), BuildError> {
+        let check = verify(&assembly, Some(&outcome.voxels));
+        if !check.is_ok() {
+            return Err(BuildError::Unverified {
+                file: self.file.clone(),
+                report: check.to_string(),
+            });
+        }
+        let by_course = by_course(&assembly);
+        let (mut assembly, name) = if verify(&by_course, Some(&outcome.voxels)).is_ok() {
+            (by_course, "by course")
+        } else {
+            (assembly, "search trace")
+        };
+        assembly.regroup(self.opts.steps);
+        Ok((assembly, name))
+    }
+}
