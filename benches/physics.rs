@@ -57,7 +57,7 @@ fn fixture_build(name: &str, studs: u32) -> Assembly {
         search::Guide {
             slant: Some(&model.slant),
             surface: Some(&model.surface),
-            colors: None,
+            ..Default::default()
         },
         &rules,
         &SearchOptions::default(),

@@ -36,7 +36,7 @@ fn build_fixture(name: &str, studs: u32, rules: &RuleSet, seed: u64) -> Built {
     let guide = Guide {
         slant: Some(&model.slant),
         surface: Some(&model.surface),
-        colors: None,
+        ..Default::default()
     };
     let out = search::build_guided(
         &model.grid,

@@ -54,10 +54,12 @@ impl<'a> Planner<'a> {
     /// fragment; with `--strict`, so is any voxel left out.
     pub(super) fn first(&self) -> Result<Plan, BuildError> {
         let (rules, opts) = (self.rules, self.opts);
-        let first = self.plan(opts.search.seed).map_err(|e| match e {
-            BuildError::Search { .. } => cover_error(rules, opts, None).unwrap_or(e),
-            e => e,
-        })?;
+        let first = self
+            .plan_told(opts.search.seed, true)
+            .map_err(|e| match e {
+                BuildError::Search { .. } => cover_error(rules, opts, None).unwrap_or(e),
+                e => e,
+            })?;
         let rep = &first.0.repairs;
         if rep.left_out > 0 {
             if let Some(e) = cover_error(rules, opts, Some(rep.left_out)) {
@@ -81,21 +83,33 @@ impl<'a> Planner<'a> {
 
     /// A verified, grouped build from the layout with `seed`.
     pub(super) fn plan(&self, seed: u64) -> Result<Plan, BuildError> {
-        let (outcome, assembly) = self.layout(seed)?;
+        self.plan_told(seed, false)
+    }
+
+    /// [`Self::plan`]; `told`: the layout's progress is shown.
+    fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
+        let (outcome, assembly) = self.layout(seed, told)?;
         let t = Instant::now();
         let (assembly, order) = self.order(&outcome, assembly)?;
         self.verify_secs.set(self.verify_secs.get() + secs(t));
         Ok((outcome, assembly, order))
     }
 
-    /// The search's pieces for `seed`, painted.
-    pub(super) fn layout(&self, seed: u64) -> Result<(SearchOutcome, Assembly), BuildError> {
+    /// The search's pieces for `seed`, painted; `told`: how far it is
+    /// goes to the progress display.
+    pub(super) fn layout(
+        &self,
+        seed: u64,
+        told: bool,
+    ) -> Result<(SearchOutcome, Assembly), BuildError> {
         let opts = self.opts;
         let model = &self.voxels.model;
+        let tell = |done, total| self.progress.advance(done, total);
         let guide = search::Guide {
             slant: Some(&model.slant),
             surface: Some(&model.surface),
             colors: self.voxels.labels.as_deref(),
+            progress: told.then_some(&tell as &dyn Fn(u64, u64)),
         };
         let search_opts = opts.search.clone().with_seed(seed);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
@@ -104,7 +118,6 @@ impl<'a> Planner<'a> {
                 reason,
             },
         )?;
-        let _ = self.progress;
         let order = search::placements(&outcome);
         let mut assembly = Assembly::from_order(&order, self.rules.layer_ldu(), Color::RED);
         assembly.paint(opts.palette, seed);

@@ -352,9 +352,23 @@ impl<'a> Layout<'a> {
     /// with the best total score is kept: greedy choices made at one end of
     /// a course decide where its seams fall at the other, so the patch as a
     /// whole is compared.
-    pub fn lay(&mut self, opts: &SearchOptions, dice: &mut Dice, deadline: Instant) {
+    /// `progress` is told the voxels laid so far and all there are, a layer
+    /// at a time.
+    pub fn lay(
+        &mut self,
+        opts: &SearchOptions,
+        dice: &mut Dice,
+        deadline: Instant,
+        progress: Option<&dyn Fn(u64, u64)>,
+    ) {
         let (_, _, nz) = self.dims;
+        let total = self.must.count() as u64;
+        let mut laid = 0;
         for z in 0..nz {
+            if let Some(tell) = progress {
+                tell(laid, total);
+            }
+            laid += self.must.count_layer(z) as u64;
             if Instant::now() >= deadline {
                 let left = (z..nz)
                     .flat_map(|k| self.must.layer_cells(k).collect::<Vec<_>>())

@@ -206,8 +206,9 @@ pub struct SearchOutcome {
     pub stats: SearchStats,
 }
 
-/// What the voxelizer knows of the mesh besides its voxels.
-#[derive(Debug, Clone, Copy, Default)]
+/// What the voxelizer knows of the mesh besides its voxels, and whom to
+/// tell how far the search is.
+#[derive(Clone, Copy, Default)]
 pub struct Guide<'a> {
     /// Where the surface slants: slopes go only there.
     pub slant: Option<&'a Slant>,
@@ -219,6 +220,20 @@ pub struct Guide<'a> {
     /// 0 for none. No piece covers surface voxels of two labels, so pieces
     /// split where the model's colours change (inner pieces may span them).
     pub colors: Option<&'a [u16]>,
+    /// Called as the layout goes up the model with the voxels laid so far
+    /// and all there are, for a progress display.
+    pub progress: Option<&'a dyn Fn(u64, u64)>,
+}
+
+impl std::fmt::Debug for Guide<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Guide")
+            .field("slant", &self.slant)
+            .field("surface", &self.surface)
+            .field("colors", &self.colors.map(<[u16]>::len))
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
 }
 
 /// Finds an ordered, connected build of `voxels` with the rules `rules`;
@@ -266,7 +281,7 @@ pub fn build_guided(
     layout.repairs = repairs;
     layout.colors = guide.colors.filter(|c| c.len() == fixed.len());
     let mut dice = Dice::new(opts.seed);
-    layout.lay(opts, &mut dice, deadline);
+    layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
     let (mut order, mut unreached) = derive::derive(&layout);
