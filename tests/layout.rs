@@ -299,3 +299,45 @@ fn rule_weights_steer_the_choice() {
         );
     }
 }
+
+/// The layout tells how far it is, a layer at a time: the counts only go
+/// up, never past the voxels there are to lay, and cover the whole model.
+#[test]
+fn the_layout_tells_its_progress_in_voxels_laid() {
+    let rules = rules(false, false);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
+    let mesh = brickwright::mesh::load(&path).unwrap();
+    let model = voxelize(
+        &mesh,
+        &VoxelizeOptions::default().with_sizing(Sizing::Studs(24)),
+    )
+    .unwrap();
+    let told = std::cell::RefCell::new(Vec::new());
+    let tell = |done, total| told.borrow_mut().push((done, total));
+    let guide = Guide {
+        slant: Some(&model.slant),
+        surface: Some(&model.surface),
+        progress: Some(&tell),
+        ..Default::default()
+    };
+    search::build_guided(&model.grid, guide, &rules, &SearchOptions::default()).unwrap();
+    let told = told.into_inner();
+    let (_, _, layers) = model.grid.dims();
+    assert_eq!(
+        told.len(),
+        layers as usize + 1,
+        "one report a layer, and one at the end"
+    );
+    let total = told[0].1;
+    // The total is the voxels the layout lays, the input's after repairs.
+    assert!(total >= model.grid.count() as u64);
+    assert!(told.iter().all(|&(_, t)| t == total));
+    assert!(told.windows(2).all(|w| w[0].0 <= w[1].0));
+    assert_eq!(told[0].0, 0);
+    assert_eq!(told.last().unwrap().0, total);
+    let before_last = told[told.len() - 2].0;
+    assert!(
+        before_last < total && before_last > total / 2,
+        "{before_last} of {total}"
+    );
+}

@@ -393,6 +393,9 @@ impl<'a> Layout<'a> {
                 self.lay_best(z, None, opts, dice);
             }
         }
+        if let Some(tell) = progress {
+            tell(total, total);
+        }
     }
 
     /// The patches of free voxels of layer `z`, joined through their faces.
