@@ -3,7 +3,8 @@
 //! A part is known by its LDraw file name ([`PartId`]) and described by its
 //! footprint in studs and its height in plates. Adding a rectangular part to
 //! the alphabet Σ is one entry in [`PARTS`]; nothing else in the code names a
-//! part number. Colours live here too, keyed by their LDraw code.
+//! part number. Colours live here too, keyed by their LDraw code, with the
+//! colours each part is made in (`catalog/part_colors.txt`).
 
 use std::fmt;
 
@@ -13,7 +14,9 @@ use crate::geom::{Body, Cell, CellBox, Rot, MAX_BODY_BOXES};
 
 mod color;
 pub mod lab;
+mod part_colors;
 pub use color::{Color, ColorSpec, Palette, COLORS, LAYER_PALETTE, RANDOM_PALETTE};
+pub use part_colors::buildable;
 
 /// An LDraw part file name without its `.dat` extension, e.g. `3001`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]

@@ -221,6 +221,7 @@ fixtures_build! {
     builds_two_tone: "two_tone.obj",
     builds_vertex_colors: "vertex_colors.obj",
     builds_textured: "textured.glb",
+    builds_speckled: "speckled.glb",
 }
 
 /// The `1` lines of an LDraw file whose part is one of `ids`.

@@ -1,12 +1,13 @@
 //! Builds keep the model's colours: the coloured fixtures (a two-material
 //! OBJ, a vertex-coloured OBJ, a textured GLB) built with the default
 //! palette and checked region by region, and the outputs carrying the
-//! colours (`.ldr` colour codes, parts list by part and colour).
+//! colours (`.ldr` colour codes, parts list by part and colour, each part
+//! in a colour it is made in); specks of a texture smoothed away.
 
 use std::path::{Path, PathBuf};
 
 use brickwright::assembly::Placed;
-use brickwright::catalog::{Color, Palette};
+use brickwright::catalog::{Color, Palette, PartKind, COLORS, PARTS};
 use brickwright::pipeline::{self, BuildOptions, BuildOutput, Formats, Silent};
 use brickwright::voxel::Sizing;
 
@@ -143,4 +144,137 @@ fn a_missing_texture_is_a_warning_and_kd_stands_in() {
     let w = &out.report.warnings[0];
     assert!(w.contains("bricks.png") && w.contains("Kd"), "{w}");
     assert_eq!(colours_where(&out, |c| c.2 <= 3), vec![Color(4)]);
+}
+
+/// Every (part, colour) a build's parts lists order, read back from the
+/// files (Rebrickable CSV: part, LDraw colour; BrickLink XML: item, BrickLink
+/// colour) and from the report, each checked against the colours the part
+/// is made in.
+fn assert_parts_exist(out: &BuildOutput, dir: &Path, stem: &str) {
+    let mut seen = 0;
+    let mut check = |part: PartKind, color: Color, from: &str| {
+        assert!(
+            part.exists_in(color),
+            "{from} orders {} in {color}, a colour it is not made in",
+            part.spec().id
+        );
+        seen += 1;
+    };
+    for r in &out.report.parts {
+        check(
+            PartKind::from_id(&r.part).unwrap(),
+            Color(r.color),
+            "report",
+        );
+    }
+    let csv = std::fs::read_to_string(dir.join(format!("{stem}-parts.csv"))).unwrap();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let part = PARTS
+            .iter()
+            .position(|p| p.rebrickable() == f[0])
+            .map(|i| PartKind(i as u16))
+            .unwrap_or_else(|| panic!("CSV part {}", f[0]));
+        check(part, Color(f[1].parse().unwrap()), "the CSV");
+    }
+    let xml = std::fs::read_to_string(dir.join(format!("{stem}-bricklink.xml"))).unwrap();
+    let tag = |item: &str, t: &str| -> String {
+        let open = format!("<{t}>");
+        let at = item.find(&open).unwrap() + open.len();
+        item[at..at + item[at..].find('<').unwrap()].to_string()
+    };
+    for item in xml.split("<ITEM>").skip(1) {
+        let id = tag(item, "ITEMID");
+        let part = PARTS
+            .iter()
+            .position(|p| p.bricklink == id)
+            .map(|i| PartKind(i as u16))
+            .unwrap_or_else(|| panic!("BrickLink item {id}"));
+        let bl: u16 = tag(item, "COLOR").parse().unwrap();
+        let color = COLORS.iter().find(|c| c.bricklink == bl).unwrap().code;
+        check(part, color, "the BrickLink list");
+    }
+    assert!(seen >= 3 * out.report.parts.len(), "{stem}: {seen} rows");
+}
+
+#[test]
+fn parts_lists_order_parts_only_in_colours_they_are_made_in() {
+    type Configure = fn(&mut BuildOptions);
+    let cases: [(&str, Configure); 8] = [
+        ("two_tone.obj", |_| {}),
+        ("vertex_colors.obj", |_| {}),
+        ("textured.glb", |_| {}),
+        ("speckled.glb", |_| {}),
+        ("speckled.glb", |o| o.max_colors = Some(2)),
+        ("vertex_colors.obj", |o| o.max_colors = Some(3)),
+        ("house.obj", |o| o.palette = Palette::Random),
+        // No 2 x 8 brick or 2 x 4 slope is made in Dark Pink: those
+        // pieces take the nearest colour they are made in.
+        ("barn.obj", |o| {
+            o.palette = Palette::Single(Color(5));
+            o.slopes = true;
+            o.sizing = Sizing::Studs(24);
+        }),
+    ];
+    for (fixture, configure) in cases {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = build(fixture, tmp.path(), |o| {
+            o.formats = Formats::parse("ldr,csv,bricklink").unwrap();
+            configure(o);
+        });
+        let stem = fixture.split('.').next().unwrap();
+        assert_parts_exist(&out, tmp.path(), stem);
+    }
+}
+
+/// The colour the build shows at each cell: the piece covering it.
+fn shown(out: &BuildOutput) -> std::collections::HashMap<(i32, i32, i32), Color> {
+    let a = &out.assembly;
+    a.pieces
+        .iter()
+        .flat_map(|p| cells(p, a.layer_ldu).into_iter().map(move |c| (c, p.color)))
+        .collect()
+}
+
+/// `speckled.glb`'s white texels `(x, row)`, row 0 at the top, and its
+/// yellow patch `x0..x1` by rows `r0..r1` (examples/make_fixtures).
+const SPECKS: [(u32, u32); 4] = [(3, 2), (6, 7), (12, 8), (9, 1)];
+const PATCH: (u32, u32, u32, u32) = (9, 13, 3, 7);
+
+#[test]
+fn specks_are_smoothed_and_real_patches_kept() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = build("speckled.glb", tmp.path(), |_| {});
+    let report = out.report.mesh_colors.as_ref().unwrap();
+    // The specks show on the front and the back; the smoothing takes them
+    // (and little else) away.
+    assert!(
+        (8..=40).contains(&report.smoothed),
+        "{} voxels smoothed",
+        report.smoothed
+    );
+    // Measured against the colours as sampled, specks included.
+    assert!(share(&out) >= 0.95, "{report:?}");
+    let at = shown(&out);
+    let ny = out.report.grid[1];
+    for face in [0, ny - 1] {
+        // Texel (x, row) is voxel (x, face, layer 9 - row).
+        for (x, row) in SPECKS {
+            let c = at[&(x as i32, face, 9 - row as i32)];
+            assert_eq!(c, Color::RED, "speck ({x}, {row}) on face {face}");
+        }
+        let (x0, x1, r0, r1) = PATCH;
+        let yellow = (x0..x1)
+            .flat_map(|x| (r0..r1).map(move |r| (x as i32, face, 9 - r as i32)))
+            .filter(|c| at[c] == Color(14))
+            .count();
+        assert!(
+            yellow >= 15,
+            "{yellow} of 16 patch voxels yellow on face {face}"
+        );
+    }
+    // The build's colours: red and yellow, no white.
+    let colours: std::collections::BTreeSet<u16> =
+        out.report.parts.iter().map(|r| r.color).collect();
+    assert_eq!(colours.into_iter().collect::<Vec<_>>(), vec![4, 14]);
 }

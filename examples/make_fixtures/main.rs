@@ -119,10 +119,12 @@ fn run(out: &Path) -> Result<Vec<Row>, String> {
     let (two_tone, obj, mtl) = colored::two_tone();
     let (vc, vc_obj) = colored::vertex_colors();
     let (tex, tex_glb) = colored::textured();
+    let (speckled, speckled_glb) = colored::speckled();
     for (file, mesh) in [
         ("two_tone.obj", &two_tone),
         ("vertex_colors.obj", &vc),
         ("textured.glb", &tex),
+        ("speckled.glb", &speckled),
     ] {
         let report = check::check(mesh);
         verify(file, &report, &[(192.0, 1e-6)])?;
@@ -132,6 +134,7 @@ fn run(out: &Path) -> Result<Vec<Row>, String> {
     files.push(("two_tone.mtl", mtl.into_bytes()));
     files.push(("vertex_colors.obj", vc_obj.into_bytes()));
     files.push(("textured.glb", tex_glb));
+    files.push(("speckled.glb", speckled_glb));
 
     let open = broken::open_box();
     let report = check::check(&open);

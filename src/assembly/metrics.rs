@@ -24,6 +24,14 @@ pub struct SeamStats {
     pub continued: usize,
     /// `continued / seams` (0 when there are no seams): lower is stronger.
     pub fraction: f64,
+    /// Of `seams`, those between pieces of two colours: where a coloured
+    /// model changes colour, the pieces must meet.
+    pub colour_seams: usize,
+    /// Of `colour_seams`, those that continue into the course above.
+    pub colour_continued: usize,
+    /// The share of the seams within one colour that continue: the bond
+    /// away from colour boundaries.
+    pub fraction_in_colour: f64,
 }
 
 /// Counts the vertical seams of `asm` and those that continue upward.
@@ -61,17 +69,28 @@ pub fn seams(asm: &Assembly) -> SeamStats {
                 z += 1;
             };
             if let (Some(&ua), Some(&ub)) = (up_a, up_b) {
+                let colour = asm.pieces[a].color != asm.pieces[b].color;
                 stats.seams += 1;
+                stats.colour_seams += usize::from(colour);
                 if ua != ub {
                     stats.continued += 1;
+                    stats.colour_continued += usize::from(colour);
                 }
             }
         }
     }
-    if stats.seams > 0 {
-        stats.fraction =
-            ((stats.continued as f64 / stats.seams as f64) * 10_000.0).round() / 10_000.0;
-    }
+    let share = |k: usize, n: usize| {
+        if n == 0 {
+            0.0
+        } else {
+            ((k as f64 / n as f64) * 10_000.0).round() / 10_000.0
+        }
+    };
+    stats.fraction = share(stats.continued, stats.seams);
+    stats.fraction_in_colour = share(
+        stats.continued - stats.colour_continued,
+        stats.seams - stats.colour_seams,
+    );
     stats
 }
 

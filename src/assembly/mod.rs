@@ -158,29 +158,46 @@ impl Assembly {
     }
 
     /// Colours every piece by `palette`; `seed` drives
-    /// [`Palette::Random`], so the same seed gives the same colours.
+    /// [`Palette::Random`], so the same seed gives the same colours. A
+    /// piece always takes a colour its part is made in: random colours are
+    /// drawn among those, and a single colour the part is not made in gives
+    /// way to the nearest one it is.
     pub fn paint(&mut self, palette: Palette, seed: u64) {
         let layer_ldu = self.layer_ldu;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         for p in &mut self.pieces {
-            p.color = match palette {
+            let part = p.placement.part;
+            let want = match palette {
                 Palette::Single(c) => c,
-                Palette::Random => RANDOM_PALETTE[rng.gen_range(0..RANDOM_PALETTE.len())],
+                Palette::Random => {
+                    let made: Vec<Color> = RANDOM_PALETTE
+                        .iter()
+                        .copied()
+                        .filter(|&c| part.exists_in(c))
+                        .collect();
+                    made[rng.gen_range(0..made.len())]
+                }
                 Palette::Layers | Palette::Mesh => {
                     // By brick course (24 LDU), whatever the layer height.
                     let course = (p.placement.origin.z * layer_ldu).div_euclid(24);
                     LAYER_PALETTE[course.rem_euclid(LAYER_PALETTE.len() as i32) as usize]
                 }
             };
+            p.color = part.nearest_color(want, None);
         }
     }
 
     /// Colours every piece from the voxel colours `colors` (cells indexed
     /// as in `grid`): the colour most of the surface voxels it covers show,
     /// else most of its voxels, else that of the nearest coloured voxel
-    /// (a piece filling only cells outside the model).
+    /// (a piece filling only cells outside the model); or, where its part
+    /// is not made in that colour, the nearest one it is made in (among
+    /// the model's colours when `--colors` limited them).
     pub fn paint_voxels(&mut self, grid: &VoxelGrid, colors: &VoxelColors) {
         let layer_ldu = self.layer_ldu;
+        let limit: Option<Vec<Color>> = colors
+            .limited
+            .then(|| colors.used.iter().map(|&(c, _)| c).collect());
         for p in &mut self.pieces {
             let body = p.placement.body(layer_ldu);
             let cells: Vec<Cell> = body.cells().filter(|&c| grid.in_bounds(c)).collect();
@@ -215,7 +232,7 @@ impl Assembly {
                 })
             };
             if let Some(c) = vote(true).or_else(|| vote(false)).or_else(near) {
-                p.color = c;
+                p.color = p.placement.part.nearest_color(c, limit.as_deref());
             }
         }
     }

@@ -45,10 +45,13 @@ pub struct MeshColorReport {
     pub colors: Vec<(u16, usize)>,
     /// Surface voxels of the model.
     pub surface_voxels: usize,
-    /// Of those, how many the build shows in their own colour.
+    /// Of those, how many the build shows in their own colour: the colour
+    /// sampled from the model, before the smoothing.
     pub own_color: usize,
     /// `own_color / surface_voxels`.
     pub own_color_share: f64,
+    /// Surface voxels the smoothing gave their neighbours' colour.
+    pub smoothed: usize,
 }
 
 /// What a build did, written to `report.json`.
@@ -225,7 +228,7 @@ pub(super) fn mesh_color_report(
         }
     }
     let (mut surface, mut own) = (0, 0);
-    for (i, (&s, want)) in c.surface.iter().zip(&c.cells).enumerate() {
+    for (i, (&s, want)) in c.surface.iter().zip(&c.sampled).enumerate() {
         if s {
             surface += 1;
             if want.is_some() && shown[i] == *want {
@@ -242,6 +245,7 @@ pub(super) fn mesh_color_report(
         } else {
             ((own as f64 / surface as f64) * 1e4).round() / 1e4
         },
+        smoothed: c.smoothed,
     }
 }
 

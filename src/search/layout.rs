@@ -42,7 +42,7 @@ use super::prepare::{neighbors6, Repairs};
 use super::rulebook::RuleBook;
 use super::{Dice, SearchOptions, SearchStats};
 use crate::assembly::Placement;
-use crate::catalog::{PartKind, Shape};
+use crate::catalog::{Color, PartKind, Shape, COLORS};
 use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
 use crate::voxel::{Slant, VoxelGrid};
@@ -224,6 +224,9 @@ pub(crate) struct Layout<'a> {
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
     pub colors: Option<&'a [u16]>,
+    /// Per colour label: whether some part of the rules is made in that
+    /// colour. Where one is, a piece showing the colour must be made in it.
+    made: Vec<bool>,
     pub shapes: Vec<PieceShape>,
     pub weights: Weights,
     /// The piece owning each cell, or [`NONE`].
@@ -309,6 +312,11 @@ impl<'a> Layout<'a> {
             }
         }
         let layer_ldu = rules.layer_ldu();
+        let shapes = shapes(rules);
+        let mut made = vec![false; COLORS.last().map_or(0, |c| c.code.0 as usize + 2)];
+        for c in COLORS {
+            made[c.code.0 as usize + 1] = shapes.iter().any(|s| s.part.exists_in(c.code));
+        }
         Layout {
             rules,
             book: RuleBook::new(rules),
@@ -318,7 +326,8 @@ impl<'a> Layout<'a> {
             near,
             slant,
             colors: None,
-            shapes: shapes(rules),
+            made,
+            shapes,
             weights: Weights::default(),
             owner: vec![NONE; must.len()],
             pieces: Vec::new(),
@@ -603,7 +612,7 @@ impl<'a> Layout<'a> {
     /// Whether the piece `body` fits: every cell free and allowed by
     /// `reach`, a slope's open face clear of the model and of pieces and
     /// slanting the way the mesh does, and on the visible surface of one
-    /// colour (see [`Layout::colors`]). Returns how many cells it fills of
+    /// colour (see [`Layout::colors`]), which its part is made in. Returns how many cells it fills of
     /// the model's voxels, of the cells the surface passes through, and of
     /// other empty cells.
     pub(super) fn fits(
@@ -641,6 +650,13 @@ impl<'a> Layout<'a> {
         }
         let (a, b) = (labels[0].1, labels[1].1);
         if a.min(b) > 0 && a.min(b) * COLOR_SLACK > a.max(b) {
+            return None;
+        }
+        // The piece shows its main colour: its part must be made in it.
+        let main = if b > a { labels[1].0 } else { labels[0].0 };
+        if self.made.get(main as usize).copied().unwrap_or(false)
+            && !placement.part.exists_in(Color(main - 1))
+        {
             return None;
         }
         if far > 0 && reach == Reach::Near {
@@ -760,7 +776,8 @@ impl<'a> Layout<'a> {
     }
 
     /// For a piece `body` with its bottom in layer `z`: the side faces that
-    /// continue a seam of the layer below, the seams below it bridges, and
+    /// continue a seam of the layer below (except where the colour
+    /// changes, see [`Layout::colour_edge`]), the seams below it bridges, and
     /// the free voxels beside it it would leave with no free neighbour.
     fn seam_terms(&self, body: &Body, z: i32) -> (usize, usize, usize) {
         let (mut seams, mut bridged, mut isolated) = (0, 0, 0);
@@ -796,19 +813,41 @@ impl<'a> Layout<'a> {
                     continue;
                 }
                 let free_voxel = self.must.get(n) && self.free(n);
-                if (free_voxel || !self.free(n)) && seam_below(q, n) {
+                if (free_voxel || !self.free(n)) && seam_below(q, n) && !self.colour_edge(q, n) {
                     seams += 1;
                 }
                 if free_voxel
-                    && !neighbors6(n)[..4]
-                        .iter()
-                        .any(|&m| !foot.contains(m) && self.must.get(m) && self.free(m))
+                    && !neighbors6(n)[..4].iter().any(|&m| {
+                        !foot.contains(m)
+                            && self.must.get(m)
+                            && self.free(m)
+                            && !self.colour_edge(n, m)
+                    })
                 {
                     isolated += 1;
                 }
             }
         }
         (seams, bridged, isolated)
+    }
+
+    /// Whether `a` and `b` are surface voxels of two colours. A seam there
+    /// is where the model changes colour, which the pieces must follow, not
+    /// a weakness a better layout would avoid; and a free voxel whose only
+    /// free neighbours are of another colour is as good as isolated.
+    fn colour_edge(&self, a: Cell, b: Cell) -> bool {
+        let Some(labels) = self.colors else {
+            return false;
+        };
+        let at = |c: Cell| {
+            if self.must.in_bounds(c) {
+                labels[self.must.index(c)]
+            } else {
+                0
+            }
+        };
+        let (x, y) = (at(a), at(b));
+        x != 0 && y != 0 && x != y
     }
 
     /// Lays `placement` (its body `body`), joined to the pieces it rests on

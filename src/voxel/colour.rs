@@ -3,7 +3,7 @@
 //! The mesh's surface is sampled as densely as the voxelizer samples it
 //! (every third of a cell or finer); each sample's colour ([`Paint::sample`]:
 //! material × texture × vertex colour) is matched to the nearest catalog
-//! colour by CIEDE2000 ([`lab::nearest_in`]), and each cell the surface
+//! colour some part is made in, by CIEDE2000 ([`lab::nearest_in`]), and each cell the surface
 //! passes through takes the colour most of its samples have. Filled cells
 //! with no sample (inner voxels, and the odd surface voxel the surface only
 //! grazes) take the colour of the nearest coloured cell, by a breadth-first
@@ -11,7 +11,9 @@
 //!
 //! With a colour limit, the model's colours are reduced first
 //! ([`lab::reduce`]: the rarest merged into its nearest in Lab), so the build
-//! uses at most that many.
+//! uses at most that many. Last, the surface colours are smoothed
+//! ([`smooth`](super::smooth)): specks and ragged edges would cut the
+//! pieces into many small ones.
 //!
 //! [`Paint::sample`]: crate::mesh::Paint::sample
 
@@ -20,22 +22,33 @@ use std::collections::{HashMap, VecDeque};
 use glam::Vec3;
 
 use super::{to_grid_frame, Up, VoxelGrid, VoxelModel};
-use crate::catalog::{lab, Color, COLORS};
+use crate::catalog::{buildable, lab, Color, COLORS};
 use crate::geom::Cell;
 use crate::mesh::{paint::linear_to_srgb, Mesh};
 
 /// The colours of a model's voxels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VoxelColors {
-    /// Per cell of the grid (by [`VoxelGrid::index`]): the colour of a filled
-    /// cell, `None` for an empty one.
+    /// Per cell of the grid (by [`VoxelGrid::index`]): the colour of a
+    /// filled cell, `None` for an empty one; on the surface, after the smoothing
+    /// ([`smooth`](super::smooth)). The colours the layout and the pieces
+    /// follow.
     pub cells: Vec<Option<Color>>,
+    /// Per cell: the colour as sampled from the model, before the
+    /// smoothing: what the build is measured against.
+    pub sampled: Vec<Option<Color>>,
+    /// Surface voxels the smoothing gave their neighbours' colour.
+    pub smoothed: usize,
     /// Per cell: whether it is a surface voxel (filled, with a face on an
     /// empty cell or the grid's edge): the voxels a viewer sees.
     pub surface: Vec<bool>,
     /// The colours used, with how many surface voxels show each, most
     /// first.
     pub used: Vec<(Color, usize)>,
+    /// Whether the colours were reduced to a limit: a piece whose part is
+    /// not made in its colour then takes the nearest of `used` it is made
+    /// in, so the build keeps to the limit.
+    pub limited: bool,
 }
 
 impl VoxelColors {
@@ -63,7 +76,13 @@ pub fn color_voxels(
 ) -> Option<VoxelColors> {
     let paint = mesh.paint.as_ref().filter(|p| p.has_color())?;
     let grid = &model.grid;
-    let all: Vec<Color> = COLORS.iter().map(|c| c.code).collect();
+    // Only colours some part is made in: a voxel of a colour no piece
+    // comes in could not be built.
+    let all: Vec<Color> = COLORS
+        .iter()
+        .map(|c| c.code)
+        .filter(|&c| buildable(c))
+        .collect();
     let mut cache: HashMap<[u8; 3], Color> = HashMap::new();
     let cell = model.cell_size();
     let mut votes: Vec<(u32, Color, u32)> = Vec::new();
@@ -127,18 +146,24 @@ pub fn color_voxels(
     spread(grid, &mut cells);
     let surface = surface_cells(grid);
     let mut used = count(&cells, &surface);
+    let limited = max_colors.is_some_and(|n| n < used.len());
     if let Some(n) = max_colors.filter(|&n| n < used.len()) {
         let weights: Vec<(Color, u64)> = used.iter().map(|&(c, w)| (c, w as u64)).collect();
         let into: HashMap<Color, Color> = lab::reduce(&weights, n).into_iter().collect();
         for c in cells.iter_mut().flatten() {
             *c = into[c];
         }
-        used = count(&cells, &surface);
     }
+    let sampled = cells.clone();
+    let smoothed = super::smooth::smooth(grid, &mut cells, &surface);
+    used = count(&cells, &surface);
     Some(VoxelColors {
         cells,
+        sampled,
+        smoothed,
         surface,
         used,
+        limited,
     })
 }
 

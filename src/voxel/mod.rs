@@ -10,4 +10,5 @@ pub use voxelize::{
     to_grid_frame, voxelize, Sizing, Slant, Up, VoxelModel, VoxelizeError, VoxelizeOptions,
 };
 pub mod colour;
+pub mod smooth;
 pub use colour::{color_voxels, VoxelColors};
