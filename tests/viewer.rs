@@ -63,11 +63,12 @@ fn chromium(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
     }
 }
 
+/// One browser at a time: three software-rendering browsers at once on
+/// two cores can miss the page's ready state within the time budget.
+static ONE_BROWSER: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn chromium_once(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
-    // One browser at a time: three software-rendering browsers at once on
-    // two cores can miss the page's ready state within the time budget.
-    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _turn = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let out = Command::new("chromium")
         .args([
             "--headless",
@@ -448,6 +449,7 @@ fn firefox_shot(
         page.file_name().unwrap().to_string_lossy()
     );
     std::fs::write(&harness, FIREFOX_HARNESS.replace("PAGE", &target)).unwrap();
+    let _turn = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let mut procs = Reaped(Vec::new());
     let mut firefox = Command::new("firefox-esr")
         .args(["--no-remote", "--kiosk", "--profile"])

@@ -553,6 +553,30 @@ mod tests {
     }
 
     #[test]
+    fn coarse_meshes_keep_the_bounds_and_the_winding_with_fewer_triangles() {
+        assert_eq!(
+            coarse_part_mesh(PartKind::from_id("3001").unwrap()).triangle_count(),
+            140
+        );
+        for part in PartKind::all() {
+            let (fine, coarse) = (part_mesh(part), coarse_part_mesh(part));
+            assert_eq!(coarse.bounds(), fine.bounds(), "{part}");
+            assert!(
+                coarse.triangle_count() * 3 < fine.triangle_count(),
+                "{part}"
+            );
+            for t in coarse.indices.chunks_exact(3) {
+                let p = [0, 1, 2].map(|k| Vec3::from(coarse.positions[t[k] as usize]));
+                let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                for &i in t {
+                    let n = Vec3::from(coarse.normals[i as usize]);
+                    assert!(n.dot(face) > 0.8, "{part}: {n} vs {face}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn bounding_boxes_are_the_catalog_sizes() {
         assert_eq!(
             mesh("3001").bounds(),

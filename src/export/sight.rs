@@ -253,10 +253,10 @@ fn open_until(grid: &Grid, solid: &[u32], steps: u32) -> Vec<u32> {
     };
     let mut open = vec![0u32; grid.len()];
     let mut buckets: Vec<Vec<usize>> = vec![Vec::new(); steps as usize + 2];
-    for i in 0..grid.len() {
+    for (i, open) in open.iter_mut().enumerate() {
         let c = grid.cell(i);
         if (0..3).any(|k| c[k] == 0 || c[k] == grid.size[k] - 1) {
-            open[i] = NEVER;
+            *open = NEVER;
             buckets[key(NEVER)].push(i);
         }
     }
