@@ -6,13 +6,23 @@
 //! model: the two screenshots show it, with the current step outlined, and
 //! differ. The page itself must name no URL.
 //!
-//! Chromium is required: without it the test fails, unless
-//! `BRICKWRIGHT_SKIP_TOOLS=1` asks to skip (`.ci/run` installs it).
+//! Firefox (Debian's `firefox-esr`) opens the page too, at the first and
+//! the last step: in a real window on a virtual X server (`Xvfb`, WebGL
+//! through Mesa's llvmpipe; headless Firefox offers no WebGL), inside a
+//! frame of a small page that waits for the viewer's ready state and logs
+//! it to standard output; ImageMagick's `import` takes the screenshot.
+//!
+//! Chromium, Firefox, Xvfb and ImageMagick are required: without one the
+//! test that needs it fails, unless `BRICKWRIGHT_SKIP_TOOLS=1` asks to skip
+//! (`.ci/run` installs them).
 
 mod common;
 
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
 
 use brickwright::pipeline::{self, BuildOptions, Formats, Silent, Stability};
 use brickwright::voxel::Sizing;
@@ -53,11 +63,12 @@ fn chromium(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
     }
 }
 
+/// One browser at a time: three software-rendering browsers at once on
+/// two cores can miss the page's ready state within the time budget.
+static ONE_BROWSER: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn chromium_once(profile: &Path, url: &str, args: &[&str]) -> (String, Vec<String>) {
-    // One browser at a time: three software-rendering browsers at once on
-    // two cores can miss the page's ready state within the time budget.
-    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _turn = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let out = Command::new("chromium")
         .args([
             "--headless",
@@ -103,12 +114,14 @@ fn body_attr(dom: &str, attr: &str) -> Option<String> {
     Some(tag[start..].split('"').next()?.to_string())
 }
 
-/// Pixels of the 3D view (the page's left part) in an RGB screenshot.
+/// Pixels of the 3D view (the page's left part) in an RGB screenshot
+/// whose top left 1000x750 pixels show the page.
 fn view_pixels(png: &Path) -> Vec<[u8; 3]> {
     let img = image::open(png)
         .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
         .to_rgb8();
-    assert_eq!(img.dimensions(), (1000, 750), "{}", png.display());
+    let (w, h) = img.dimensions();
+    assert!(w >= 1000 && h >= 750, "{}: {w}x{h}", png.display());
     let mut px = Vec::new();
     for y in 0..560 {
         for x in 0..600 {
@@ -135,8 +148,6 @@ fn chromium_shows_the_first_and_the_last_step() {
         return;
     }
     let profile = tmp.path().join("profile");
-    let background = [0xee, 0xf0, 0xf3];
-    let highlight = [0xff, 0x9e, 0x00];
     let mut shots = Vec::new();
     for step in [1, steps] {
         let url = format!("file://{}#step={step}", page.display());
@@ -157,18 +168,39 @@ fn chromium_shows_the_first_and_the_last_step() {
         let shot = format!("--screenshot={}", png.display());
         let (_, console) = chromium(&profile, &url, &[&shot]);
         assert!(console.is_empty(), "{url}: the console says {console:#?}");
-        let px = view_pixels(&png);
-        let model = px.iter().filter(|&&p| far(p, background, 24)).count();
-        let outlined = px.iter().filter(|&&p| !far(p, highlight, 40)).count();
-        assert!(model * 50 > px.len(), "step {step}: {model} model pixels");
-        assert!(outlined > 100, "step {step}: {outlined} highlight pixels");
-        if std::env::var_os("VIEWER_SHOTS").is_some() {
-            let keep = PathBuf::from(std::env::var_os("VIEWER_SHOTS").unwrap());
-            std::fs::create_dir_all(&keep).unwrap();
-            std::fs::copy(&png, keep.join(format!("step-{step}.png"))).unwrap();
-        }
-        shots.push((model, px));
+        shots.push(shows_the_model(&png, step, "chromium"));
     }
+    first_and_last_differ(&shots);
+}
+
+/// The model's pixels in the view of screenshot `png` at `step`, after
+/// checking that the model and the current step's outline show; kept in
+/// `$VIEWER_SHOTS` when set.
+fn shows_the_model(png: &Path, step: u32, browser: &str) -> (usize, Vec<[u8; 3]>) {
+    let background = [0xee, 0xf0, 0xf3];
+    let highlight = [0xff, 0x9e, 0x00];
+    if let Some(keep) = std::env::var_os("VIEWER_SHOTS") {
+        let keep = PathBuf::from(keep);
+        std::fs::create_dir_all(&keep).unwrap();
+        std::fs::copy(png, keep.join(format!("{browser}-step-{step}.png"))).unwrap();
+    }
+    let px = view_pixels(png);
+    let model = px.iter().filter(|&&p| far(p, background, 24)).count();
+    let outlined = px.iter().filter(|&&p| !far(p, highlight, 40)).count();
+    assert!(
+        model * 50 > px.len(),
+        "{browser}, step {step}: {model} model pixels"
+    );
+    assert!(
+        outlined > 100,
+        "{browser}, step {step}: {outlined} highlight pixels"
+    );
+    (model, px)
+}
+
+/// The finished model covers more of the view than the first step, and
+/// the two views differ.
+fn first_and_last_differ(shots: &[(usize, Vec<[u8; 3]>)]) {
     let (first, last) = (&shots[0], &shots[1]);
     assert!(
         last.0 > first.0,
@@ -309,4 +341,202 @@ fn keys_buttons_slider_and_address_move_between_steps() {
         "hash=2/1/ready/#step=2".into(),
     ];
     assert_eq!(log.split(' ').collect::<Vec<_>>(), want, "{dom}");
+}
+
+/// The page that holds the viewer page in a 1000x750 frame at the window's
+/// top left and, once the viewer is no longer loading (or after 90 s) and
+/// has drawn, logs `viewer-test: STATE/STEP` to the console.
+const FIREFOX_HARNESS: &str = r##"<!DOCTYPE html>
+<html><head><style>
+body { margin: 0; overflow: hidden; }
+iframe { border: 0; width: 1000px; height: 750px; position: absolute; left: 0; top: 0; }
+</style></head>
+<body><iframe id="f"></iframe>
+<script>
+var f = document.getElementById("f"), started = Date.now();
+f.src = "PAGE";
+function state() {
+  var b = f.contentDocument && f.contentDocument.body;
+  return (b && b.getAttribute("data-state") || "loading") + "/" + (b && b.getAttribute("data-step"));
+}
+function poll() {
+  if (state().indexOf("loading") === 0 && Date.now() - started < 90000) {
+    setTimeout(poll, 200);
+    return;
+  }
+  // Two frames more, and a moment: the last drawing is on the screen.
+  requestAnimationFrame(function () {
+    requestAnimationFrame(function () {
+      setTimeout(function () { console.log("viewer-test: " + state()); }, 500);
+    });
+  });
+}
+poll();
+</script>
+</body></html>
+"##;
+
+/// Firefox's settings for a test: the page's console on standard output,
+/// frames of local files readable by the page around them, and none of
+/// the browser's own network traffic.
+const FIREFOX_PREFS: &str = r#"user_pref("devtools.console.stdout.content", true);
+user_pref("security.fileuri.strict_origin_policy", false);
+user_pref("browser.shell.checkDefaultBrowser", false);
+user_pref("browser.startup.homepage_override.mstone", "ignore");
+user_pref("datareporting.policy.dataSubmissionEnabled", false);
+user_pref("toolkit.telemetry.reportingpolicy.firstRun", false);
+user_pref("app.update.disabledForTesting", true);
+user_pref("services.settings.server", "data:,#remote-settings-dummy/v1");
+user_pref("browser.safebrowsing.update.enabled", false);
+user_pref("extensions.update.enabled", false);
+user_pref("network.captive-portal-service.enabled", false);
+user_pref("network.connectivity-service.enabled", false);
+user_pref("network.proxy.type", 0);
+"#;
+
+/// Processes ended when the test ends, however it ends.
+struct Reaped(Vec<Child>);
+
+impl Drop for Reaped {
+    fn drop(&mut self) {
+        // Firefox first, then the X server it draws on.
+        for child in self.0.iter_mut().rev() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Starts a virtual X server on a free display; its number.
+fn start_xvfb(procs: &mut Reaped) -> String {
+    let mut xvfb = Command::new("Xvfb")
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            "1280x900x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("Xvfb runs");
+    let out = xvfb.stdout.take().unwrap();
+    procs.0.push(xvfb);
+    let mut line = String::new();
+    BufReader::new(out).read_line(&mut line).unwrap();
+    let display = line.trim().to_string();
+    assert!(!display.is_empty(), "Xvfb named no display");
+    format!(":{display}")
+}
+
+/// Firefox showing `page#step=STEP` on `display`: the viewer's state and
+/// step as the harness saw them, the console lines and a screenshot.
+fn firefox_shot(
+    dir: &Path,
+    display: &str,
+    page: &Path,
+    step: u32,
+) -> (String, Vec<String>, PathBuf) {
+    let profile = dir.join(format!("firefox-{step}"));
+    std::fs::create_dir_all(&profile).unwrap();
+    std::fs::write(profile.join("user.js"), FIREFOX_PREFS).unwrap();
+    let harness = dir.join(format!("firefox-{step}.html"));
+    let target = format!(
+        "{}#step={step}",
+        page.file_name().unwrap().to_string_lossy()
+    );
+    std::fs::write(&harness, FIREFOX_HARNESS.replace("PAGE", &target)).unwrap();
+    let _turn = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
+    let mut procs = Reaped(Vec::new());
+    let mut firefox = Command::new("firefox-esr")
+        .args(["--no-remote", "--kiosk", "--profile"])
+        .arg(&profile)
+        .arg(format!("file://{}", harness.display()))
+        .env("DISPLAY", display)
+        .env_remove("MOZ_HEADLESS")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("firefox-esr runs");
+    let (tx, rx) = mpsc::channel();
+    for pipe in [
+        Box::new(firefox.stdout.take().unwrap()) as Box<dyn std::io::Read + Send>,
+        Box::new(firefox.stderr.take().unwrap()),
+    ] {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+    }
+    procs.0.push(firefox);
+    let mut lines = Vec::new();
+    let state = loop {
+        match rx.recv_timeout(Duration::from_secs(150)) {
+            Ok(line) => {
+                if let Some(rest) = line.split("viewer-test: ").nth(1) {
+                    break rest.trim_end_matches('"').to_string();
+                }
+                lines.push(line);
+            }
+            Err(e) => panic!("firefox said nothing of the viewer ({e}): {lines:#?}"),
+        }
+    };
+    let png = dir.join(format!("firefox-step-{step}.png"));
+    let shot = Command::new("import")
+        .args(["-display", display, "-window", "root"])
+        .arg(&png)
+        .output()
+        .expect("import runs");
+    assert!(
+        shot.status.success(),
+        "import: {}",
+        String::from_utf8_lossy(&shot.stderr)
+    );
+    drop(procs);
+    // The page's own messages: its console calls and the script errors and
+    // warnings (WebGL's among them) that name a file of the test.
+    let dir_url = format!("file://{}", dir.display());
+    let console = lines
+        .into_iter()
+        .filter(|l| {
+            l.starts_with("console.error: \"")
+                || l.starts_with("console.warn: \"")
+                || (l.starts_with("JavaScript") && l.contains(&dir_url))
+        })
+        .collect();
+    (state, console, png)
+}
+
+#[test]
+fn firefox_shows_the_first_and_the_last_step() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (page, steps) = build_page("house.obj", 10, tmp.path());
+    let tools = [
+        ("firefox-esr", "firefox-esr", "--version"),
+        ("Xvfb", "xvfb", "-help"),
+        ("import", "imagemagick", "-version"),
+    ];
+    if !tools
+        .iter()
+        .all(|&(n, p, v)| common::required_tool(n, p, v))
+    {
+        return;
+    }
+    let mut xvfb = Reaped(Vec::new());
+    let display = start_xvfb(&mut xvfb);
+    let mut shots = Vec::new();
+    for step in [1, steps] {
+        let (state, console, png) = firefox_shot(tmp.path(), &display, &page, step);
+        assert_eq!(state, format!("ready/{step}"), "firefox at step {step}");
+        assert!(console.is_empty(), "firefox at step {step}: {console:#?}");
+        shots.push(shows_the_model(&png, step, "firefox"));
+    }
+    first_and_last_differ(&shots);
 }

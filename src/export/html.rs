@@ -22,35 +22,47 @@
 //! - `parts`: every part type the build uses, in catalog order, with its
 //!   triangle mesh from [`partmesh`](super::partmesh) (positions and normals
 //!   as little-endian `f32`, indices as `u16` or `u32`, each base64), so a
-//!   brick looks as it does in the glTF and the step images;
+//!   brick looks as it does in the glTF and the step images, and its
+//!   [coarse](super::partmesh::coarse_part_mesh) mesh in the same buffers;
 //! - `colors`: every colour used, with its LDraw code, name and sRGB;
 //! - `rotations`: the four quarter-turn matrices (LDraw's, row-major);
 //! - `pieces`: one row per piece in build order,
-//!   `[part, colour, step, rotation, x, y, z, ex, ey, ez, covered]`: indices
-//!   into the tables above, the step, the LDraw position in LDU (-Y up)
-//!   exactly as the `.ldr` line has it, the exploded-view offset, and the
-//!   step from which every stud of the piece is covered (0 if never).
+//!   `[part, colour, step, rotation, x, y, z, ex, ey, ez, top, bottom, +x,
+//!   -x, +z, -z]`: indices into the tables above, the step, the LDraw
+//!   position in LDU (-Y up) exactly as the `.ldr` line has it, the
+//!   exploded-view offset, and the step from which each face of the piece
+//!   is out of sight (0 if never; see [`sight`](super::sight)).
 //!
-//! A piece takes about 52 bytes, a part type 10 to 70 kB of mesh: the
-//! 5,701-piece build of a 64-stud box (11 part types) makes a 578 kB page.
-//! The viewer draws it in a few instanced calls per part type.
+//! A piece takes about 70 bytes, a part type 6 to 65 kB of mesh: the
+//! 15,397-piece build of a 64-stud box (11 part types) makes a 1.4 MB
+//! page. The viewer draws it in a few instanced calls per part type.
 //!
 //! The address picks the view: `page.html#step=12` opens at step 12 (out
 //! of range goes to the nearest step), `&exploded=1` exploded, and the
 //! address follows the viewer. Without WebGL the page says so, and the step
 //! controls and parts lists still work.
 //!
-//! # Covered studs
+//! # Drawing little
 //!
 //! Studs are most of a part's triangles (a 2x8 brick has 1,334, its body
-//! about 40), and in a solid model most of them are hidden under the next
-//! course. So each part also has `bareIndices`: its triangles without the
-//! studs and the studded top, drawn from the same vertices. From the step
-//! at which the cells over a piece's studs are all filled (`covered`), the
-//! viewer draws that piece bare; nothing visible changes (the piece above
-//! sits flat on the dropped top face), and a finished 5,000-piece box draws
-//! a few hundred thousand triangles instead of seven million. The exploded
-//! view, which opens the gaps, draws every piece whole.
+//! about 40), and in a solid model most pieces cannot be seen at all. So
+//! the viewer draws, at each step, only what can be seen from outside:
+//!
+//! - a piece whose six faces are all [out of sight](super::sight) is left
+//!   out;
+//! - a piece whose top is out of sight is drawn bare: the coarse mesh's
+//!   body without studs or top face (`bareIndices`);
+//! - a face (bottom or side) out of sight is folded to a point in the
+//!   vertex shader, which finds a vertex's face from its normal and the
+//!   part's bounds, so it costs no fragment;
+//! - when a stud is a few pixels wide, whole pieces are drawn with the
+//!   coarse mesh (`coarseIndices`: a 2x4 brick in 140 triangles, not 678).
+//!
+//! Nothing visible from outside changes; a camera moved inside the model
+//! draws everything. The exploded view, which opens the gaps, draws every
+//! piece whole. The finished 15,397-piece box at 64 studs draws 114
+//! thousand triangles a frame instead of 1.6 million (with its studs
+//! coarse: 5 pixels wide in a 660x490 view).
 //! The same assembly and options always give byte-identical pages.
 //!
 //! # Example
@@ -75,17 +87,17 @@
 //! assert!(!page.contains("http://") && !page.contains("https://"));
 //! ```
 
-use std::collections::HashMap;
 use std::io::{self, Write};
 
 use base64::Engine as _;
 use serde::Serialize;
 
 use super::explode::{explode, ExplodeOptions};
-use super::partmesh::{part_mesh, piece_transform, PartMesh};
+use super::partmesh::{coarse_part_mesh, part_mesh, piece_transform, PartMesh};
+use super::sight::sight;
 use crate::assembly::Assembly;
 use crate::catalog::{Color, PartKind};
-use crate::geom::{Cell, Rot};
+use crate::geom::Rot;
 use crate::ldraw::rot_matrix;
 
 /// The page around the viewer: markup with `{{TITLE}}`, `{{STYLE}}`,
@@ -145,13 +157,13 @@ pub struct ViewerModel {
     /// The quarter turns' rotation matrices, row-major, indexed by
     /// [`Rot`] order.
     pub rotations: [[i32; 9]; 4],
-    /// `[part, colour, step, rotation, x, y, z, ex, ey, ez]` per piece, in
-    /// build order.
+    /// One [`PieceRow`] per piece, in build order.
     pub pieces: Vec<PieceRow>,
 }
 
-/// One piece: `[part, colour, step, rotation, x, y, z, ex, ey, ez,
-/// covered]`.
+/// One piece: `[part, colour, step, rotation, x, y, z, ex, ey, ez, top,
+/// bottom, +x, -x, +z, -z]`: the last six are the steps from which its
+/// faces are out of sight ([`Sight`](super::sight::Sight), 0 for never).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PieceRow(
     pub u32,
@@ -165,6 +177,11 @@ pub struct PieceRow(
     pub f32,
     pub f32,
     pub u32,
+    pub u32,
+    pub u32,
+    pub u32,
+    pub u32,
+    pub u32,
 );
 
 /// A part type and its mesh.
@@ -175,17 +192,21 @@ pub struct ViewerPart {
     pub id: String,
     /// Part name.
     pub name: String,
-    /// Vertex count.
+    /// Vertex count: the full mesh's, then the coarse mesh's.
     pub vertices: usize,
-    /// Positions in LDU, the part's LDraw frame: base64 of `f32` LE triples.
+    /// Positions in LDU, the part's LDraw frame: base64 of `f32` LE
+    /// triples, the full mesh's vertices then the coarse mesh's.
     pub positions: String,
     /// Unit normals: base64 of `f32` LE triples.
     pub normals: String,
-    /// Triangle indices: base64 of `u16` LE, or `u32` LE when
+    /// The full mesh's triangles: base64 of `u16` LE, or `u32` LE when
     /// [`ViewerPart::index32`].
     pub indices: String,
-    /// The triangles without the studs and the studded top face, for a
-    /// piece whose studs are all covered: base64 like
+    /// The [coarse](coarse_part_mesh) mesh's triangles, for pieces a few
+    /// pixels wide: base64 like [`ViewerPart::indices`].
+    pub coarse_indices: String,
+    /// The coarse mesh without the studs and the studded top face, for a
+    /// piece whose top is out of sight: base64 like
     /// [`ViewerPart::indices`].
     pub bare_indices: String,
     /// Whether indices are 32-bit.
@@ -219,13 +240,13 @@ impl ViewerModel {
         colors.sort_unstable();
         colors.dedup();
         let offsets = explode(assembly, &opts.explode);
-        let covered = covered_steps(assembly);
+        let seen = sight(assembly);
         let pieces = assembly
             .pieces
             .iter()
             .zip(&offsets)
-            .zip(&covered)
-            .map(|((p, e), &covered)| {
+            .zip(&seen)
+            .map(|((p, e), seen)| {
                 let pl = &p.placement;
                 let t = piece_transform(pl, assembly.layer_ldu).translation;
                 let index = |v: usize| v as u32;
@@ -240,7 +261,12 @@ impl ViewerModel {
                     round2(e.x),
                     round2(e.y),
                     round2(e.z),
-                    covered,
+                    seen.top,
+                    seen.sides[0],
+                    seen.sides[1],
+                    seen.sides[2],
+                    seen.sides[3],
+                    seen.sides[4],
                 )
             })
             .collect();
@@ -277,30 +303,6 @@ fn round2(v: f32) -> f32 {
     (v * 100.0).round() / 100.0
 }
 
-/// For each piece, the step from which a piece fills every cell just over
-/// its studs (0 when that never happens): from then on its studs and its
-/// studded top cannot be seen in the assembled model.
-fn covered_steps(assembly: &Assembly) -> Vec<u32> {
-    let layer = assembly.layer_ldu;
-    let mut filled: HashMap<Cell, u32> = HashMap::new();
-    for p in &assembly.pieces {
-        for c in p.placement.body(layer).cells() {
-            filled.insert(c, p.step.0);
-        }
-    }
-    assembly
-        .pieces
-        .iter()
-        .map(|p| {
-            let over = p.placement.body(layer).over_studs();
-            let step = over
-                .cells()
-                .try_fold(0, |step, c| filled.get(&c).map(|&s| step.max(s)));
-            step.unwrap_or(0)
-        })
-        .collect()
-}
-
 /// The triangles of `mesh` that stay visible when its studs are covered:
 /// none with a corner above the top (`y < 0`, a stud) nor lying in the
 /// top plane (`y = 0`, the studded top face).
@@ -316,7 +318,9 @@ fn bare_triangles(mesh: &PartMesh) -> Vec<u32> {
 
 fn viewer_part(part: PartKind) -> ViewerPart {
     let spec = part.spec();
-    let mesh = part_mesh(part);
+    let (mesh, coarse) = (part_mesh(part), coarse_part_mesh(part));
+    let base = mesh.positions.len() as u32;
+    let shifted = |indices: &[u32]| -> Vec<u32> { indices.iter().map(|i| i + base).collect() };
     let b64 = |bytes: Vec<u8>| base64::engine::general_purpose::STANDARD.encode(bytes);
     let floats = |v: &[[f32; 3]]| {
         b64(v
@@ -325,7 +329,8 @@ fn viewer_part(part: PartKind) -> ViewerPart {
             .flat_map(|f| f.to_le_bytes())
             .collect::<Vec<u8>>())
     };
-    let index32 = mesh.positions.len() > usize::from(u16::MAX);
+    let vertices = mesh.positions.len() + coarse.positions.len();
+    let index32 = vertices > usize::from(u16::MAX);
     let encode = |indices: &[u32]| {
         if index32 {
             b64(indices.iter().flat_map(|i| i.to_le_bytes()).collect())
@@ -340,11 +345,12 @@ fn viewer_part(part: PartKind) -> ViewerPart {
     ViewerPart {
         id: spec.id.0.to_string(),
         name: spec.name.to_string(),
-        vertices: mesh.positions.len(),
-        positions: floats(&mesh.positions),
-        normals: floats(&mesh.normals),
+        vertices,
+        positions: floats(&[&mesh.positions[..], &coarse.positions].concat()),
+        normals: floats(&[&mesh.normals[..], &coarse.normals].concat()),
         indices: encode(&mesh.indices),
-        bare_indices: encode(&bare_triangles(mesh)),
+        coarse_indices: encode(&shifted(&coarse.indices)),
+        bare_indices: encode(&shifted(&bare_triangles(coarse))),
         index32,
         center: [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
         half: [0, 1, 2].map(|k| (hi[k] - lo[k]) / 2.0),
@@ -398,6 +404,7 @@ fn escape_script(json: &str) -> String {
 mod tests {
     use super::*;
     use crate::assembly::Placement;
+    use crate::geom::Cell;
 
     fn page(asm: &Assembly, opts: &HtmlOptions) -> String {
         let mut out = Vec::new();
@@ -499,7 +506,8 @@ mod tests {
         let asm = wall(3);
         let model = model_json(&page(&asm, &HtmlOptions::default()));
         let p = &model["parts"][0];
-        let mesh = part_mesh(PartKind::from_id("3001").unwrap());
+        let brick = PartKind::from_id("3001").unwrap();
+        let (mesh, coarse) = (part_mesh(brick), coarse_part_mesh(brick));
         let dec = |k: &str| {
             base64::engine::general_purpose::STANDARD
                 .decode(p[k].as_str().unwrap())
@@ -509,16 +517,30 @@ mod tests {
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
             .collect();
-        let want: Vec<f32> = mesh.positions.iter().flatten().copied().collect();
-        assert_eq!(pos, want);
-        assert_eq!(dec("normals").len(), 12 * mesh.normals.len());
-        assert_eq!(p["index32"], false);
-        let idx: Vec<u32> = dec("indices")
-            .chunks_exact(2)
-            .map(|b| u32::from(u16::from_le_bytes([b[0], b[1]])))
+        let want: Vec<f32> = [&mesh.positions[..], &coarse.positions]
+            .concat()
+            .into_iter()
+            .flatten()
             .collect();
-        assert_eq!(idx, mesh.indices);
-        assert_eq!(p["vertices"], mesh.positions.len());
+        assert_eq!(pos, want);
+        let n = mesh.positions.len();
+        assert_eq!(p["vertices"], n + coarse.positions.len());
+        assert_eq!(dec("normals").len(), 4 * want.len());
+        assert_eq!(p["index32"], false);
+        let ints = |k: &str| -> Vec<u32> {
+            dec(k)
+                .chunks_exact(2)
+                .map(|b| u32::from(u16::from_le_bytes([b[0], b[1]])))
+                .collect()
+        };
+        assert_eq!(ints("indices"), mesh.indices);
+        // The coarse mesh's triangles, and its bare ones, index its own
+        // vertices, after the full mesh's.
+        let coarse_idx: Vec<u32> = coarse.indices.iter().map(|i| i + n as u32).collect();
+        assert_eq!(ints("coarseIndices"), coarse_idx);
+        let bare = ints("bareIndices");
+        assert!(!bare.is_empty() && bare.len() < coarse_idx.len());
+        assert!(bare.iter().all(|i| coarse_idx.contains(i)));
         assert_eq!(p["center"], serde_json::json!([0.0, 10.0, 0.0]));
     }
 
@@ -553,25 +575,28 @@ mod tests {
     }
 
     #[test]
-    fn studs_count_as_covered_once_every_cell_over_them_is_filled() {
+    fn rows_carry_the_steps_from_which_faces_are_out_of_sight() {
         // Course 0 spans x 0..32, course 1 (steps 3 and 4) x 2..34.
         let asm = wall(16);
-        let covered = covered_steps(&asm);
-        assert_eq!(covered[0], 0, "its left half stays open");
-        assert_eq!(covered[1], 3);
-        assert_eq!(covered[4..8], [4, 4, 4, 4]);
-        assert!(
-            covered[8..].iter().all(|&c| c == 0),
-            "the top course is open"
-        );
+        let seen = sight(&asm);
         let rows = model_json(&page(&asm, &HtmlOptions::default()));
+        for (row, s) in rows["pieces"].as_array().unwrap().iter().zip(&seen) {
+            let faces: Vec<u64> = (10..16).map(|k| row[k].as_u64().unwrap()).collect();
+            assert_eq!(faces[0], u64::from(s.top));
+            assert_eq!(faces[1..], s.sides.map(u64::from));
+        }
+        assert_eq!(rows["pieces"][0][10], 0, "its left half stays open");
         assert_eq!(rows["pieces"][1][10], 3);
+        // The second brick's ends touch the first (step 1) and the third
+        // (step 1) bricks of the course.
+        assert_eq!(rows["pieces"][1][12], 1);
+        assert_eq!(rows["pieces"][1][13], 1);
     }
 
     #[test]
     fn bare_meshes_drop_the_studs_and_the_top_and_keep_the_rest() {
         for part in PartKind::all() {
-            let mesh = part_mesh(part);
+            let mesh = coarse_part_mesh(part);
             let bare = bare_triangles(mesh);
             assert!(bare.len().is_multiple_of(3) && !bare.is_empty(), "{part}");
             assert!(
@@ -581,7 +606,7 @@ mod tests {
             );
             if ["3001", "3007"].contains(&part.spec().id.0) {
                 assert!(
-                    bare.len() * 8 < mesh.indices.len(),
+                    bare.len() * 40 < part_mesh(part).indices.len(),
                     "{part}: {}",
                     bare.len()
                 );

@@ -21,3 +21,4 @@ pub mod gltf;
 pub mod html;
 pub mod partmesh;
 pub mod partslist;
+pub mod sight;

@@ -63,6 +63,9 @@ use crate::ldraw::{placement_position, rot_matrix};
 /// Sides of a stud's cylinder.
 pub const STUD_SEGMENTS: usize = 16;
 
+/// Sides of a stud's prism in a [`coarse_part_mesh`].
+pub const COARSE_STUD_SEGMENTS: usize = 6;
+
 /// A stud's radius in LDU.
 pub const STUD_RADIUS: f32 = 6.0;
 
@@ -133,6 +136,22 @@ pub fn part_mesh(part: PartKind) -> &'static PartMesh {
     meshes.get(part.0 as usize).unwrap_or(&EMPTY)
 }
 
+/// The mesh of `part` with fewer triangles, for pieces drawn a few pixels
+/// wide (the step viewer's level of detail): the same body with a plain
+/// top face, and studs as [`COARSE_STUD_SEGMENTS`]-sided prisms standing
+/// on it, open at the foot. Same bounds and outward winding as
+/// [`part_mesh`]; a 2x4 brick has 140 triangles instead of 678.
+pub fn coarse_part_mesh(part: PartKind) -> &'static PartMesh {
+    static MESHES: OnceLock<Vec<PartMesh>> = OnceLock::new();
+    static EMPTY: PartMesh = PartMesh {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        indices: Vec::new(),
+    };
+    let meshes = MESHES.get_or_init(|| PARTS.iter().map(build_coarse_part_mesh).collect());
+    meshes.get(part.0 as usize).unwrap_or(&EMPTY)
+}
+
 /// The affine map from `p`'s part frame to LDraw world coordinates (LDU),
 /// exactly as the `.ldr` line places it: the rotation
 /// [`rot_matrix`]`(rot)` followed by the translation
@@ -162,24 +181,49 @@ pub fn piece_transform(p: &Placement, layer_ldu: i32) -> Affine3A {
 
 /// Builds the mesh of one catalog entry (uncached; see [`part_mesh`]).
 pub fn build_part_mesh(spec: &PartSpec) -> PartMesh {
-    let w = i32::from(spec.studs_x.max(1));
-    let d = i32::from(spec.studs_y.max(1));
-    let h = spec.height_ldu().max(8) as f32;
-    let hx = 10.0 * w as f32;
-    let profile = Profile::of(spec.shape, d, h);
-    // Stud columns across the width, rows (centres along z) on the top.
-    let columns: Vec<f32> = (0..w).map(|i| (20 * i - 10 * w + 10) as f32).collect();
-    let rows: Vec<f32> = match spec.shape {
-        Shape::Rect => (0..d).map(|j| (20 * j - 10 * d + 10) as f32).collect(),
-        Shape::Slope => vec![0.0],
-        Shape::Inverted => (0..d).rev().map(|j| (-20 * j) as f32).collect(),
-    };
+    let (profile, hx, columns, rows) = layout(spec);
     let mut b = Builder::default();
     b.studded_top(&columns, &rows);
     let x_extras = edge_points(&columns);
     let z_extras = edge_points(&rows);
     b.prism(&profile, hx, &x_extras, &z_extras);
     b.mesh
+}
+
+/// Builds the mesh of [`coarse_part_mesh`] (uncached).
+pub fn build_coarse_part_mesh(spec: &PartSpec) -> PartMesh {
+    let (profile, hx, columns, rows) = layout(spec);
+    let mut b = Builder::default();
+    b.prism(&profile, hx, &[], &[]);
+    let (zb, zf) = (profile.corners[1][0], profile.corners[2][0]);
+    let top = [[-hx, zb], [hx, zb], [hx, zf], [-hx, zf]].map(|[x, z]| Vec3::new(x, 0.0, z));
+    b.polygon(&top, Vec3::NEG_Y);
+    for &cz in &rows {
+        for &cx in &columns {
+            b.stud_prism(cx, cz);
+        }
+    }
+    b.mesh
+}
+
+/// A part's profile, half width and the centres of its stud columns (x)
+/// and rows (z).
+fn layout(spec: &PartSpec) -> (Profile, f32, Vec<f32>, Vec<f32>) {
+    let w = i32::from(spec.studs_x.max(1));
+    let d = i32::from(spec.studs_y.max(1));
+    let h = spec.height_ldu().max(8) as f32;
+    let columns: Vec<f32> = (0..w).map(|i| (20 * i - 10 * w + 10) as f32).collect();
+    let rows: Vec<f32> = match spec.shape {
+        Shape::Rect => (0..d).map(|j| (20 * j - 10 * d + 10) as f32).collect(),
+        Shape::Slope => vec![0.0],
+        Shape::Inverted => (0..d).rev().map(|j| (-20 * j) as f32).collect(),
+    };
+    (
+        Profile::of(spec.shape, d, h),
+        10.0 * w as f32,
+        columns,
+        rows,
+    )
 }
 
 /// Offsets, from a cell's centre, of the 16 points where rays from the
@@ -364,6 +408,28 @@ impl Builder {
         }
     }
 
+    /// A coarse stud on the cell centred at `(cx, cz)`: a prism's sides,
+    /// smooth as a full stud's, and its cap.
+    fn stud_prism(&mut self, cx: f32, cz: f32) {
+        let n = COARSE_STUD_SEGMENTS;
+        let dir = |k: usize| {
+            let a = std::f32::consts::TAU * (k % n) as f32 / n as f32;
+            Vec3::new(a.cos(), 0.0, a.sin())
+        };
+        let at = |k: usize, y: f32| Vec3::new(cx, y, cz) + dir(k) * STUD_RADIUS;
+        let top = -STUD_HEIGHT;
+        for k in 0..n {
+            let a = self.vertex(at(k, 0.0), dir(k));
+            let b = self.vertex(at(k + 1, 0.0), dir(k + 1));
+            let c = self.vertex(at(k + 1, top), dir(k + 1));
+            let e = self.vertex(at(k, top), dir(k));
+            // Wound as a full stud's side (see `studded_top`).
+            self.mesh.indices.extend([a, b, c, a, c, e]);
+        }
+        let cap: Vec<Vec3> = (0..n).map(|k| at(k, top)).collect();
+        self.polygon(&cap, Vec3::NEG_Y);
+    }
+
     /// The body: the profile extruded over `x` in `±hx`, with the top face
     /// left to [`Builder::studded_top`]. `x_extras` and `z_extras` are the
     /// points the top face puts on its outer edges (across and along the
@@ -483,6 +549,30 @@ mod tests {
             assert_eq!(m.triangle_count(), expected_triangles(spec), "{part}");
             assert_eq!(m.positions.len(), m.normals.len());
             assert!(m.indices.iter().all(|&i| (i as usize) < m.positions.len()));
+        }
+    }
+
+    #[test]
+    fn coarse_meshes_keep_the_bounds_and_the_winding_with_fewer_triangles() {
+        assert_eq!(
+            coarse_part_mesh(PartKind::from_id("3001").unwrap()).triangle_count(),
+            140
+        );
+        for part in PartKind::all() {
+            let (fine, coarse) = (part_mesh(part), coarse_part_mesh(part));
+            assert_eq!(coarse.bounds(), fine.bounds(), "{part}");
+            assert!(
+                coarse.triangle_count() * 3 < fine.triangle_count(),
+                "{part}"
+            );
+            for t in coarse.indices.chunks_exact(3) {
+                let p = [0, 1, 2].map(|k| Vec3::from(coarse.positions[t[k] as usize]));
+                let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                for &i in t {
+                    let n = Vec3::from(coarse.normals[i as usize]);
+                    assert!(n.dot(face) > 0.8, "{part}: {n} vs {face}");
+                }
+            }
         }
     }
 

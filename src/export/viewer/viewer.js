@@ -39,12 +39,16 @@
   var steps = model.steps;
   var colors = model.colors.map(function (c) { return hexColor(c.rgb); });
   // Instances grouped by part type, in build order. For each step the
-  // group's shown pieces are laid out in its instance buffer as three runs:
-  // earlier pieces whose studs are covered (drawn bare), the other earlier
-  // pieces (whole), and the current step's (whole, highlighted).
-  var STRIDE = 18; // floats: rotation columns (9), position (3), explode offset (3), colour (3)
+  // group's shown pieces are laid out in its instance buffer as four runs:
+  // earlier pieces out of sight (drawn only from inside the model), the
+  // other earlier pieces whose top is out of sight (drawn bare), the rest
+  // of the earlier pieces (whole), and the current step's (whole,
+  // highlighted). Each instance carries the faces out of sight as a bit
+  // mask (bottom, +X, -X, +Z, -Z: src/export/sight.rs), folded away by the
+  // vertex shader.
+  var STRIDE = 19; // floats: rotation columns (9), position (3), explode offset (3), colour (3), mask (1)
   var groups = model.parts.map(function (part) {
-    return { part: part, rows: [], source: null, data: null, runs: [0, 0, 0] };
+    return { part: part, rows: [], source: null, data: null, runs: [0, 0, 0, 0] };
   });
   model.pieces.forEach(function (row) { groups[row[0]].rows.push(row); });
   groups.forEach(function (g) {
@@ -54,23 +58,30 @@
       var m = model.rotations[row[3]], c = colors[row[1]];
       // Columns of the row-major LDraw matrix.
       g.source.set([m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8],
-        row[4], row[5], row[6], row[7], row[8], row[9], c[0], c[1], c[2]], i * STRIDE);
+        row[4], row[5], row[6], row[7], row[8], row[9], c[0], c[1], c[2], 0], i * STRIDE);
     });
   });
-  // Lays out every group's instances for step s; bare drawing only when
+  // Lays out every group's instances for step s; faces left out only when
   // the model is assembled (the exploded view opens the gaps).
-  function arrange(s, bare) {
+  function arrange(s, assembled) {
     groups.forEach(function (g) {
-      var runs = [[], [], []];
+      var runs = [[], [], [], []], masks = [];
       g.rows.forEach(function (row, i) {
         if (row[2] > s) return;
-        var covered = bare && row[10] > 0 && row[10] <= s;
-        runs[row[2] === s ? 2 : covered ? 0 : 1].push(i);
+        var mask = 0, out = assembled;
+        for (var k = 0; k < 5; k++) {
+          if (assembled && row[11 + k] > 0 && row[11 + k] <= s) mask += 1 << k;
+          else out = false;
+        }
+        var bare = assembled && row[10] > 0 && row[10] <= s;
+        runs[row[2] === s ? 3 : out && bare ? 0 : bare ? 1 : 2].push(i);
+        masks[i] = mask;
       });
       var n = 0;
       runs.forEach(function (run, k) {
         run.forEach(function (i) {
           g.data.set(g.source.subarray(i * STRIDE, (i + 1) * STRIDE), n * STRIDE);
+          g.data[n * STRIDE + 18] = masks[i];
           n++;
         });
         g.runs[k] = run.length;
@@ -95,10 +106,10 @@
         hi[r] = Math.max(hi[r], c + h);
       }
     });
-    if (!isFinite(lo[0])) return { center: [0, 0, 0], radius: 100 };
+    if (!isFinite(lo[0])) return { center: [0, 0, 0], radius: 100, lo: [0, 0, 0], hi: [0, 0, 0] };
     var center = [0, 1, 2].map(function (k) { return (lo[k] + hi[k]) / 2; });
     var radius = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2;
-    return { center: center, radius: Math.max(radius, 20) };
+    return { center: center, radius: Math.max(radius, 20), lo: lo, hi: hi };
   }
   var layouts = [bounds(0), bounds(1)];
 
@@ -113,18 +124,19 @@
     var l = Math.hypot(a[0], a[1], a[2]) || 1;
     return [a[0] / l, a[1] / l, a[2] / l];
   }
-  function lookAt(eye, target, up) {
+  function lookAt(eye, target, up, out) {
     var z = normalize(sub(eye, target)), x = normalize(cross(up, z)), y = cross(z, x);
-    return new Float32Array([x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0,
+    out.set([x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0,
       -dot(x, eye), -dot(y, eye), -dot(z, eye), 1]);
+    return out;
   }
-  function perspective(fovy, aspect, near, far) {
+  function perspective(fovy, aspect, near, far, out) {
     var f = 1 / Math.tan(fovy / 2), nf = 1 / (near - far);
-    return new Float32Array([f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1,
+    out.set([f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1,
       0, 0, 2 * far * near * nf, 0]);
+    return out;
   }
-  function multiply(a, b) {
-    var out = new Float32Array(16);
+  function multiply(a, b, out) {
     for (var c = 0; c < 4; c++) {
       for (var r = 0; r < 4; r++) {
         var s = 0;
@@ -165,18 +177,35 @@
 
   // ---------------------------------------------------------------- WebGL
 
+  // A vertex on a face of the part's bounding box, with that face's
+  // normal, belongs to the face (bottom, +X, -X, +Z, -Z: bits 0 to 4 of the
+  // instance's mask); a masked face is folded to a point outside the view.
   var VERTEX = [
     "attribute vec3 aPos; attribute vec3 aNormal;",
     "attribute vec3 iR0; attribute vec3 iR1; attribute vec3 iR2;",
-    "attribute vec3 iT; attribute vec3 iE; attribute vec3 iColor;",
-    "uniform mat4 uViewProj; uniform float uExplode; uniform vec3 uCenter; uniform float uGrow;",
+    "attribute vec3 iT; attribute vec3 iE; attribute vec4 iColor;",
+    "uniform mat4 uViewProj; uniform float uExplode; uniform vec3 uCenter; uniform vec3 uHalf;",
+    "uniform float uGrow; uniform float uMasking;",
     "varying vec3 vNormal; varying vec3 vColor; varying vec3 vWorld;",
+    "float face() {",
+    "  vec3 q = aPos - uCenter, e = uHalf - 0.01;",
+    "  if (aNormal.y > 0.5 && q.y > e.y) return 1.0;",
+    "  if (aNormal.x > 0.5 && q.x > e.x) return 2.0;",
+    "  if (aNormal.x < -0.5 && q.x < -e.x) return 4.0;",
+    "  if (aNormal.z > 0.5 && q.z > e.z) return 8.0;",
+    "  if (aNormal.z < -0.5 && q.z < -e.z) return 16.0;",
+    "  return 0.0;",
+    "}",
     "void main() {",
     "  mat3 r = mat3(iR0, iR1, iR2);",
     "  vec3 p = aPos + sign(aPos - uCenter) * uGrow;",
     "  vec3 w = r * p + iT + uExplode * iE;",
-    "  vNormal = r * aNormal; vColor = iColor; vWorld = w;",
+    "  vNormal = r * aNormal; vColor = iColor.rgb; vWorld = w;",
     "  gl_Position = uViewProj * vec4(w, 1.0);",
+    "  float bit = face();",
+    "  if (uMasking > 0.5 && bit > 0.5 && mod(floor(iColor.a / bit), 2.0) > 0.5) {",
+    "    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);",
+    "  }",
     "}"
   ].join("\n");
   var FRAGMENT = [
@@ -205,17 +234,33 @@
 
   var gl = null, draw = null, program = null, loc = {}, meshes = [];
 
+  // A context that can be had without a major performance caveat (a GPU),
+  // antialiased; else (a software renderer, where multisampling costs
+  // most of the frame) one without antialiasing.
+  function openContext() {
+    var fast = { antialias: true, alpha: false, depth: true, powerPreference: "high-performance",
+      failIfMajorPerformanceCaveat: true };
+    var slow = { antialias: false, alpha: false, depth: true };
+    var opts = [fast, slow];
+    for (var k = 0; k < opts.length; k++) {
+      var c = canvas.getContext("webgl2", opts[k]);
+      if (c) return { gl: c, webgl2: true };
+      c = canvas.getContext("webgl", opts[k]) || canvas.getContext("experimental-webgl", opts[k]);
+      if (c) return { gl: c, webgl2: false };
+    }
+    return null;
+  }
+
   function initGL() {
-    var opts = { antialias: true, alpha: false, depth: true, powerPreference: "high-performance" };
-    gl = canvas.getContext("webgl2", opts);
-    if (gl) {
+    var opened = openContext();
+    gl = opened && opened.gl;
+    if (opened && opened.webgl2) {
       draw = {
         divisor: function (i, d) { gl.vertexAttribDivisor(i, d); },
         elements: function (n, type, count) { gl.drawElementsInstanced(gl.TRIANGLES, n, type, 0, count); },
         index32: true
       };
     } else {
-      gl = canvas.getContext("webgl", opts) || canvas.getContext("experimental-webgl", opts);
       var ext = gl && gl.getExtension("ANGLE_instanced_arrays");
       if (!ext) {
         gl = null;
@@ -246,8 +291,8 @@
     if (!gl.getProgramParameter(program, gl.LINK_STATUS) && !gl.isContextLost()) {
       throw new Error("shader program: " + gl.getProgramInfoLog(program));
     }
-    ["uViewProj", "uExplode", "uCenter", "uGrow", "uLight", "uEye", "uUp", "uMode",
-      "uHighlight"].forEach(function (name) { loc[name] = gl.getUniformLocation(program, name); });
+    ["uViewProj", "uExplode", "uCenter", "uHalf", "uGrow", "uMasking", "uLight", "uEye", "uUp",
+      "uMode", "uHighlight"].forEach(function (name) { loc[name] = gl.getUniformLocation(program, name); });
     meshes = groups.map(function (g) {
       var p = g.part;
       if (p.index32 && !draw.index32) throw new Error("part " + p.id + " needs 32-bit indices");
@@ -260,14 +305,16 @@
       var ints = function (b64) {
         return p.index32 ? new Uint32Array(decode(b64)) : new Uint16Array(decode(b64));
       };
-      var indices = ints(p.indices), bare = ints(p.bareIndices);
+      var triangles = function (b64) {
+        var indices = ints(b64);
+        return { buffer: buffer(gl.ELEMENT_ARRAY_BUFFER, indices), count: indices.length };
+      };
       return {
         positions: buffer(gl.ARRAY_BUFFER, new Float32Array(decode(p.positions))),
         normals: buffer(gl.ARRAY_BUFFER, new Float32Array(decode(p.normals))),
-        indices: buffer(gl.ELEMENT_ARRAY_BUFFER, indices),
-        count: indices.length,
-        bare: buffer(gl.ELEMENT_ARRAY_BUFFER, bare),
-        bareCount: bare.length,
+        whole: triangles(p.indices),
+        coarse: triangles(p.coarseIndices),
+        bare: triangles(p.bareIndices),
         type: p.index32 ? gl.UNSIGNED_INT : gl.UNSIGNED_SHORT,
         instances: buffer(gl.ARRAY_BUFFER, g.data)
       };
@@ -278,23 +325,25 @@
     return true;
   }
 
-  // Draws instances [from, to) of group i, whole or bare.
-  function drawRange(i, from, to, bare) {
+  // Draws instances [from, to) of group i with one of its meshes ("whole",
+  // "coarse" or "bare").
+  function drawRange(i, from, to, mesh) {
     if (to <= from) return;
-    var m = meshes[i];
+    var m = meshes[i], t = m[mesh];
     gl.bindBuffer(gl.ARRAY_BUFFER, m.positions);
     gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
     gl.bindBuffer(gl.ARRAY_BUFFER, m.normals);
     gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 0, 0);
     gl.bindBuffer(gl.ARRAY_BUFFER, m.instances);
     for (var a = 0; a < 6; a++) {
-      gl.vertexAttribPointer(2 + a, 3, gl.FLOAT, false, STRIDE * 4, (from * STRIDE + 3 * a) * 4);
+      gl.vertexAttribPointer(2 + a, a < 5 ? 3 : 4, gl.FLOAT, false, STRIDE * 4, (from * STRIDE + 3 * a) * 4);
     }
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, bare ? m.bare : m.indices);
-    draw.elements(bare ? m.bareCount : m.count, m.type, to - from);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, t.buffer);
+    draw.elements(t.count, m.type, to - from);
+    state.triangles += t.count / 3 * (to - from);
   }
 
-  var state = { step: 1, explode: 0, stats: null };
+  var state = { step: 1, explode: 0, triangles: 0 };
 
   function resize() {
     var dpr = Math.min(window.devicePixelRatio || 1, 2);
@@ -306,6 +355,20 @@
     }
   }
 
+  // Whole pieces are drawn coarse when a stud, at the model's nearest
+  // point, is narrower than this many pixels.
+  var COARSE_STUD_PIXELS = 8;
+  var STUD_DIAMETER = 12; // LDU
+  var view = new Float32Array(16), proj = new Float32Array(16), viewProj = new Float32Array(16);
+
+  // The distance from e to the box of a layout, 0 inside it.
+  function distanceTo(layout, e) {
+    var d = [0, 1, 2].map(function (k) {
+      return Math.max(layout.lo[k] - e[k], 0, e[k] - layout.hi[k]);
+    });
+    return Math.hypot(d[0], d[1], d[2]);
+  }
+
   function render() {
     resize();
     gl.viewport(0, 0, canvas.width, canvas.height);
@@ -315,14 +378,21 @@
     var layout = layouts[state.explode > 0.5 ? 1 : 0];
     var reach = camera.dist + Math.hypot.apply(null, sub(camera.target, layout.center)) + layout.radius * 1.5;
     var near = Math.max(camera.dist - layout.radius * 1.5, reach / 2000, 0.5);
-    var view = lookAt(e, camera.target, UP);
-    var proj = perspective(FOV, canvas.width / canvas.height, near, reach);
+    lookAt(e, camera.target, UP, view);
+    perspective(FOV, canvas.width / canvas.height, near, reach, proj);
     // A light from the upper left, fixed to the camera.
     var right = [view[0], view[4], view[8]], up = [view[1], view[5], view[9]], back = [view[2], view[6], view[10]];
     var light = normalize([0, 1, 2].map(function (k) { return -0.45 * right[k] + 0.75 * up[k] + 0.6 * back[k]; }));
+    // From inside the model (a camera zoomed into it) the faces left out
+    // would show: draw everything there.
+    var gap = distanceTo(layout, e);
+    var masking = state.explode === 0 && gap > 0 ? 1 : 0;
+    var studPixels = STUD_DIAMETER * canvas.height / (2 * Math.max(gap, near) * Math.tan(FOV / 2));
+    var whole = studPixels < COARSE_STUD_PIXELS ? "coarse" : "whole";
     gl.useProgram(program);
-    gl.uniformMatrix4fv(loc.uViewProj, false, multiply(proj, view));
+    gl.uniformMatrix4fv(loc.uViewProj, false, multiply(proj, view, viewProj));
     gl.uniform1f(loc.uExplode, state.explode);
+    gl.uniform1f(loc.uMasking, masking);
     gl.uniform3fv(loc.uLight, light);
     gl.uniform3fv(loc.uEye, e);
     gl.uniform3fv(loc.uUp, UP);
@@ -340,30 +410,38 @@
       });
       uploaded = true;
     }
-    var ranges = groups.map(function (g) {
-      return [g.runs[0], g.runs[0] + g.runs[1], g.runs[0] + g.runs[1] + g.runs[2]];
-    });
+    state.triangles = 0;
     // Earlier steps as built; the current step tinted, then outlined: the
     // back faces of a slightly grown copy, a rim wherever it shows.
     gl.uniform1f(loc.uGrow, 0);
     gl.uniform1i(loc.uMode, 0);
-    groups.forEach(function (g, i) {
+    var i, g, r;
+    for (i = 0; i < groups.length; i++) {
+      g = groups[i];
+      r = g.runs;
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, 0, ranges[i][0], true);
-      drawRange(i, ranges[i][0], ranges[i][1], false);
-    });
+      gl.uniform3fv(loc.uHalf, g.part.half);
+      drawRange(i, masking ? r[0] : 0, r[0] + r[1], "bare");
+      drawRange(i, r[0] + r[1], r[0] + r[1] + r[2], whole);
+    }
     gl.uniform1i(loc.uMode, 1);
-    groups.forEach(function (g, i) {
+    for (i = 0; i < groups.length; i++) {
+      g = groups[i];
+      r = g.runs;
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, ranges[i][1], ranges[i][2], false);
-    });
+      gl.uniform3fv(loc.uHalf, g.part.half);
+      drawRange(i, r[0] + r[1] + r[2], r[0] + r[1] + r[2] + r[3], whole);
+    }
     gl.cullFace(gl.FRONT);
     gl.uniform1i(loc.uMode, 2);
+    gl.uniform1f(loc.uMasking, 0);
     gl.uniform1f(loc.uGrow, Math.min(Math.max(2.2 * worldPerPixel(), 0.6), 8));
-    groups.forEach(function (g, i) {
+    for (i = 0; i < groups.length; i++) {
+      g = groups[i];
+      r = g.runs;
       gl.uniform3fv(loc.uCenter, g.part.center);
-      drawRange(i, ranges[i][1], ranges[i][2], false);
-    });
+      drawRange(i, r[0] + r[1] + r[2], r[0] + r[1] + r[2] + r[3], whole);
+    }
     gl.cullFace(gl.BACK);
     for (a = 2; a < 8; a++) draw.divisor(a, 0);
   }
@@ -534,7 +612,7 @@
   }
   function pan(dx, dy) {
     moved = true;
-    var view = lookAt(eye(), camera.target, UP), wpp = worldPerPixel();
+    var view = lookAt(eye(), camera.target, UP, new Float32Array(16)), wpp = worldPerPixel();
     for (var k = 0; k < 3; k++) {
       camera.target[k] += (-dx * view[4 * k] + dy * view[4 * k + 1]) * wpp;
     }
@@ -654,21 +732,29 @@
   if (!drawing) return;
 
   // "#bench=N": draw N frames at once, turning the model, and report the
-  // frame rate (in the console and as the body's data-fps).
+  // frame rate, the triangles a frame draws and the script's own time a
+  // frame (in the console and as the body's data-fps, data-triangles and
+  // data-script-ms).
   var bench = /(?:^#|&)bench=(\d+)/.exec(window.location.hash || "");
   if (bench) {
-    var frames = Math.max(1, parseInt(bench[1], 10)), pixel = new Uint8Array(4);
+    var frames = Math.max(1, parseInt(bench[1], 10)), pixel = new Uint8Array(4), script = 0;
     render();
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
     var t0 = performance.now();
     for (var i = 0; i < frames; i++) {
+      var t1 = performance.now();
       orbit(6, 0);
       render();
+      script += performance.now() - t1;
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
     }
     var fps = frames * 1000 / Math.max(1, performance.now() - t0);
     body.setAttribute("data-fps", fps.toFixed(1));
-    console.log("brickwright viewer: " + model.pieces.length + " pieces, " + frames + " frames, " +
-      fps.toFixed(1) + " frames a second at " + canvas.width + "x" + canvas.height);
+    body.setAttribute("data-triangles", String(state.triangles));
+    body.setAttribute("data-script-ms", (script / frames).toFixed(2));
+    console.log("brickwright viewer: " + model.pieces.length + " pieces, step " + state.step + ", " +
+      frames + " frames, " + fps.toFixed(1) + " frames a second at " + canvas.width + "x" +
+      canvas.height + ", " + state.triangles + " triangles a frame, script " +
+      (script / frames).toFixed(2) + " ms a frame");
   }
 })();
