@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+pub mod hollow;
 pub mod pictures;
 pub mod stability;
 
@@ -424,6 +425,10 @@ pub struct BuildReport {
     /// LDraw colours of the build that have no known BrickLink or
     /// Rebrickable id (their parts-list lines say so).
     pub unmapped_colors: Vec<u16>,
+    /// A hollow build's size beside the solid build it replaces; absent
+    /// for a solid build.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hollow: Option<hollow::HollowReport>,
     /// Connected components of the finished build (1 when verified).
     pub components: usize,
     /// Steps in the outputs.
@@ -807,6 +812,23 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         }
     };
 
+    let guide = search::Guide {
+        slant: Some(&model.slant),
+        surface: Some(&model.surface),
+        colors: labels.as_deref(),
+    };
+    let hollow = hollow::report(
+        &assembly,
+        &outcome,
+        &model.grid,
+        guide,
+        &rules,
+        &opts.search,
+    )
+    .map_err(|reason| BuildError::Search {
+        file: file.clone(),
+        reason,
+    })?;
     // What the booklet and the `.ldr` say of a support column's step.
     let step_notes: std::collections::BTreeMap<u32, String> = stability
         .iter()
@@ -954,6 +976,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
             .as_ref()
             .map(|c| mesh_color_report(&assembly, &model.grid, c)),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
+        hollow,
         components: crate::assembly::verify::components(&assembly),
         steps: assembly.step_count(),
         booklet_pages: formats

@@ -11,3 +11,5 @@ pub use voxelize::{
 };
 pub mod colour;
 pub use colour::{color_voxels, VoxelColors};
+pub mod hollow;
+pub use hollow::{hollow, Hollowed, Wall};
