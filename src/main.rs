@@ -387,11 +387,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
         .with_seed(a.seed)
         .with_time_budget(time_budget)
         .with_complex_every(a.complex_every)
-        .with_hollow(
-            a.hollow
-                .then(|| brickwright::voxel::Wall::new(a.wall))
-                .flatten(),
-        );
+        .with_hollow(brickwright::voxel::Wall::new(a.wall).filter(|_| a.hollow));
     let spinners = Spinners {
         bar: Default::default(),
     };
@@ -457,6 +453,13 @@ fn run_build(a: BuildArgs) -> Result<()> {
             outln!(
                 "  repairs: {} islands joined ({} voxels of supports and bridges), {} voxels added to make one-layer sheets two layers thick, {} voxels added to even flat tops to whole courses, {} cells outside the surface filled to join thin features",
                 rep.joined_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.extra_cells
+            );
+        }
+        if let Some(h) = &r.hollow {
+            outln!(
+                "  hollow: walls {} thick, {} pieces ({} inside as pillars) and {:.0} g where the solid build takes {} pieces and {:.0} g ({:.0}% of its pieces, {:.0}% of its mass)",
+                h.wall, h.hollow.pieces, h.inner_pieces, h.hollow.mass_g, h.solid.pieces, h.solid.mass_g,
+                100.0 * h.pieces_share, 100.0 * h.mass_share
             );
         }
         let q = &r.quality;

@@ -833,7 +833,12 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let step_notes: std::collections::BTreeMap<u32, String> = stability
         .iter()
         .flat_map(|(r, _)| &r.supports)
-        .map(|c| (c.step, SUPPORT_NOTE.to_string()))
+        .map(|c| {
+            (
+                c.step,
+                hollow::note(c, outcome.emptied.as_ref()).to_string(),
+            )
+        })
         .collect();
     let stem = opts
         .input

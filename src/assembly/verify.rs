@@ -668,6 +668,68 @@ mod tests {
             .collect()
     }
 
+    /// A ring of 2 x 2 bricks on the ground round a 2 x 2 hole, closed by
+    /// three 2 x 6 bricks over it; `inner` is a 2 x 2 brick in the hole,
+    /// put in before the lid or after it.
+    fn closed_box(inner_first: bool) -> Assembly {
+        let ring = [
+            (0, 0),
+            (2, 0),
+            (4, 0),
+            (0, 2),
+            (4, 2),
+            (0, 4),
+            (2, 4),
+            (4, 4),
+        ];
+        let mut pieces: Vec<(&str, i32, i32, i32, Rot)> =
+            ring.iter().map(|&(x, y)| ("3003", x, y, 0, R0)).collect();
+        let inner = ("3003", 2, 2, 0, R0);
+        if inner_first {
+            pieces.push(inner);
+        }
+        pieces.extend([0, 2, 4].map(|y| ("2456", 0, y, 1, R0)));
+        if !inner_first {
+            pieces.push(inner);
+        }
+        build(&pieces)
+    }
+
+    #[test]
+    fn a_piece_inside_a_closed_cavity_is_refused() {
+        // The lid first: the piece in the hole is shut in (the table under
+        // it is no way in, though nothing stands between it and the ground).
+        let late = verify(&closed_box(false), None);
+        assert_eq!(
+            late.failures,
+            vec![Failure::Enclosed {
+                piece: 11,
+                step: Step(12)
+            }],
+            "{late}"
+        );
+        assert!(
+            late.to_string().contains("inside a closed cavity"),
+            "{late}"
+        );
+        // The same piece before the lid: built while the box is open.
+        let early = verify(&closed_box(true), None);
+        assert!(early.is_ok(), "{early}");
+    }
+
+    #[test]
+    fn the_last_piece_closing_a_cavity_goes_in_from_outside() {
+        // A lid piece goes into the last gap from above; a piece under an
+        // overhang comes in from the side.
+        let asm = build(&[
+            ("3003", 0, 0, 0, R0),
+            ("3003", 4, 0, 0, R0),
+            ("2456", 0, 0, 1, R0),
+            ("3003", 2, 0, 0, R0),
+        ]);
+        assert!(verify(&asm, None).is_ok());
+    }
+
     #[test]
     fn slopes_take_studs_on_their_back_row_only() {
         // A 2x2 slope on a 2x4 (half-brick layers: a brick is two), its

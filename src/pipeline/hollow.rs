@@ -10,7 +10,9 @@
 use serde::Serialize;
 
 use crate::assembly::{Assembly, Placement};
+use crate::geom::Cell;
 use crate::grammar::RuleSet;
+use crate::physics::support::Column;
 use crate::search::{self, Guide, SearchError, SearchOptions, SearchOutcome};
 use crate::voxel::VoxelGrid;
 
@@ -102,6 +104,21 @@ pub fn report(
         hollow,
         solid,
     }))
+}
+
+/// The booklet's note on a step that adds an inner pillar of a hollow
+/// build: a support column standing in its emptied inside.
+pub const PILLAR_NOTE: &str = "Inner pillar: inside the shell, it holds up what is over the hollow";
+
+/// The note on the step of support column `c`: an inner pillar when it
+/// stands in the cells a hollow build `emptied`, else a support column.
+pub fn note(c: &Column, emptied: Option<&VoxelGrid>) -> &'static str {
+    let inside = emptied.is_some_and(|e| e.get(Cell::new(c.x, c.y, c.bottom)));
+    if inside {
+        PILLAR_NOTE
+    } else {
+        crate::pipeline::SUPPORT_NOTE
+    }
 }
 
 /// `a / b` to four places, 0 when `b` is.

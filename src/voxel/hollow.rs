@@ -15,8 +15,9 @@
 //!   floor, and the shell is closed all the same).
 //! - A lid over the hollow is at least as thick as the thinnest sheet that
 //!   holds together (two courses of bricks side by side do, one does not).
-//! - Pockets too narrow for a 2 x 2 column of empty cells are refilled: a
-//!   one-stud slot in a wall costs more pieces than it saves.
+//! - Pockets narrower than [`MIN_HOLE`] studs are filled again: a slot
+//!   under a ridge costs more pieces, short ones bridging it, than it
+//!   saves.
 //!
 //! What holds a lid or a roof over the hollow is decided later, by the
 //! stability stage, which adds inner pillars where the statics need them.
@@ -38,6 +39,11 @@ use serde::Serialize;
 
 use super::VoxelGrid;
 use crate::geom::Cell;
+
+/// The narrowest hollow, in studs both ways: a narrower pocket is filled
+/// again, as a slot under a ridge or between two walls costs more pieces
+/// (short ones, bridging it) than it saves.
+pub const MIN_HOLE: i32 = 4;
 
 /// The thickest wall `--wall` takes, in studs.
 pub const MAX_WALL: u32 = 16;
@@ -90,7 +96,7 @@ pub fn hollow(solid: &VoxelGrid, wall: Wall, course: i32, min_lid: i32) -> Hollo
             inner.set(c, true);
         }
     }
-    let emptied = open_2x2(&inner);
+    let emptied = open_square(&inner);
     let mut shell = solid.clone();
     for c in emptied.cells() {
         shell.set(c, false);
@@ -155,20 +161,39 @@ fn deep_in_column(g: &VoxelGrid, c: Cell, up: i32) -> bool {
         && (1..=up).all(|k| c.z - k < 0 || g.get(c.offset(0, 0, -k)))
 }
 
-/// The cells of `g` that lie in a 2 x 2 square of its cells in their layer.
-fn open_2x2(g: &VoxelGrid) -> VoxelGrid {
+/// The cells of `g` that lie in a [`MIN_HOLE`]-wide square of its cells
+/// in their layer.
+fn open_square(g: &VoxelGrid) -> VoxelGrid {
     let (nx, ny, nz) = g.dims();
+    let k = MIN_HOLE;
+    // Per cell, the side of the biggest square of cells whose corner of
+    // highest x and y it is (dynamic programming over the layer).
+    let mut side = vec![0i32; g.len()];
     let mut out = VoxelGrid::new(nx, ny, nz);
-    let square = |x: i32, y: i32, z: i32| {
-        [(0, 0), (1, 0), (0, 1), (1, 1)]
-            .iter()
-            .all(|&(dx, dy)| g.get(Cell::new(x + dx, y + dy, z)))
-    };
-    for c in g.cells() {
-        for (ox, oy) in [(0, 0), (-1, 0), (0, -1), (-1, -1)] {
-            if square(c.x + ox, c.y + oy, c.z) {
-                out.set(c, true);
-                break;
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = Cell::new(x, y, z);
+                if !g.get(c) {
+                    continue;
+                }
+                let at = |dx: i32, dy: i32| {
+                    let q = c.offset(dx, dy, 0);
+                    if q.x < 0 || q.y < 0 {
+                        0
+                    } else {
+                        side[g.index(q)]
+                    }
+                };
+                let s = 1 + at(-1, 0).min(at(0, -1)).min(at(-1, -1));
+                side[g.index(c)] = s;
+                if s >= k {
+                    for dy in 0..k {
+                        for dx in 0..k {
+                            out.set(c.offset(-dx, -dy, 0), true);
+                        }
+                    }
+                }
             }
         }
     }
@@ -195,11 +220,11 @@ mod tests {
     #[test]
     fn a_block_keeps_walls_as_thick_as_asked_and_no_floor() {
         for n in [1, 2, 3] {
-            let g = block(12, 9, 10);
+            let g = block(14, 11, 10);
             let h = hollow(&g, Wall::new(n).unwrap(), 1, 2);
             let lid = (n as i32).max(2);
             for c in g.cells() {
-                let edge = c.x.min(c.y).min(11 - c.x).min(8 - c.y);
+                let edge = c.x.min(c.y).min(13 - c.x).min(10 - c.y);
                 let inside = edge >= n as i32 && c.z < 10 - lid;
                 assert_eq!(h.emptied.get(c), inside, "wall {n}, cell {c:?}");
                 assert_eq!(h.shell.get(c), !inside);
@@ -217,13 +242,16 @@ mod tests {
     }
 
     #[test]
-    fn thin_parts_stay_solid_and_narrow_pockets_are_refilled() {
-        // A slab 5 studs deep: with walls of 2 only its middle row is
-        // farther than 2 from the outside, one stud wide: kept.
-        let g = block(20, 5, 8);
-        let h = hollow(&g, Wall::DEFAULT, 1, 2);
-        assert!(h.emptied.is_empty());
-        assert_eq!(h.shell, g);
+    fn thin_parts_stay_solid_and_narrow_pockets_are_filled_again() {
+        // A slab 4 studs deep: every voxel within 2 of the outside.
+        let thin = block(20, 4, 8);
+        assert_eq!(hollow(&thin, Wall::DEFAULT, 1, 2).shell, thin);
+        // 7 deep: a pocket 3 studs wide inside, too narrow to keep.
+        let narrow = block(20, 7, 8);
+        assert!(hollow(&narrow, Wall::DEFAULT, 1, 2).emptied.is_empty());
+        // 8 deep: a pocket 4 studs wide, kept.
+        let wide = hollow(&block(20, 8, 8), Wall::DEFAULT, 1, 2);
+        assert_eq!(wide.emptied.count(), 16 * 4 * 6);
     }
 
     #[test]
