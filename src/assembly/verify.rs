@@ -240,8 +240,17 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
         }
         occupied.add(b);
     }
+    // One failure a piece: one that cannot move at all is not also shut in.
+    let stuck: HashSet<usize> = failures
+        .iter()
+        .filter_map(|f| match f {
+            Failure::Overlap { b, .. } => Some(*b),
+            Failure::NotPlaceable { piece, .. } => Some(*piece),
+            _ => None,
+        })
+        .collect();
     failures.extend(
-        enclosed(&boxes, &overlapping)
+        enclosed(&boxes, &stuck)
             .into_iter()
             .map(|i| Failure::Enclosed {
                 piece: i,
@@ -422,14 +431,14 @@ impl Occupied {
     }
 }
 
-/// The pieces (not overlapping any earlier one) whose box, at their turn,
+/// The pieces (but those in `skip`) whose box, at their turn,
 /// no path of free cells joins to the space around the build.
 ///
 /// Taken in reverse build order, the free space only grows: each piece
 /// taken away frees its cells, and a flood from the outside spreads into
 /// them when they touch it. Every cell is flooded once, so the check costs
 /// the build's bounding box and the pieces' boxes, not their product.
-fn enclosed(boxes: &[CellBox], overlapping: &HashSet<usize>) -> Vec<usize> {
+fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
     let Some(first) = boxes.first() else {
         return Vec::new();
     };
@@ -529,7 +538,7 @@ fn enclosed(boxes: &[CellBox], overlapping: &HashSet<usize>) -> Vec<usize> {
                 flood(&mut queue, &mut outside, &taken);
             }
         }
-        if !overlapping.contains(&k) && !b.cells().any(|c| index(c).is_some_and(|i| outside[i])) {
+        if !skip.contains(&k) && !b.cells().any(|c| index(c).is_some_and(|i| outside[i])) {
             shut.push(k);
         }
     }
@@ -668,9 +677,9 @@ mod tests {
             .collect()
     }
 
-    /// A ring of 2 x 2 bricks on the ground round a 2 x 2 hole, closed by
-    /// three 2 x 6 bricks over it; `inner` is a 2 x 2 brick in the hole,
-    /// put in before the lid or after it.
+    /// A ring of 2 x 2 bricks on the ground round a 2 x 2 hole, closed by a
+    /// lid of two courses of 2 x 6 bricks; `inner` is a 2 x 2 brick in the
+    /// hole, put in before the lid or after it.
     fn closed_box(inner_first: bool) -> Assembly {
         let ring = [
             (0, 0),
@@ -689,6 +698,8 @@ mod tests {
             pieces.push(inner);
         }
         pieces.extend([0, 2, 4].map(|y| ("2456", 0, y, 1, R0)));
+        // Across the lid, holding its rows together.
+        pieces.extend([0, 2, 4].map(|x| ("2456", x, 0, 2, R90)));
         if !inner_first {
             pieces.push(inner);
         }
@@ -703,8 +714,8 @@ mod tests {
         assert_eq!(
             late.failures,
             vec![Failure::Enclosed {
-                piece: 11,
-                step: Step(12)
+                piece: 14,
+                step: Step(15)
             }],
             "{late}"
         );
