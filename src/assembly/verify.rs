@@ -39,6 +39,13 @@
 //!   straight below it (down to the bottom of `O`) is empty, the piece is
 //!   placeable by a straight vertical move. A piece that overlaps an earlier
 //!   one is reported as an overlap only.
+//! - **Never inside a closed cavity** ([`Failure::Enclosed`]): the cells of
+//!   the piece's box must be joined, through cells no earlier piece takes
+//!   (face to face), to the space around the build: beside its bounding
+//!   box or over it, never under the build's lowest layer, which stands on
+//!   the table. The placeability search may pass below the ground, as a
+//!   piece goes in under an overhang; this rule keeps a hollow model's
+//!   inside from being built after its shell closes over it.
 //!
 //! # Example
 //!
@@ -94,6 +101,14 @@ pub enum Failure {
         /// Its step.
         step: Step,
     },
+    /// Earlier pieces close a cavity around the piece: no path of empty
+    /// cells joins it to the space around the build.
+    Enclosed {
+        /// The piece.
+        piece: usize,
+        /// Its step.
+        step: Step,
+    },
     /// The pieces' cells differ from the target's filled cells.
     CoverMismatch {
         /// Target cells no piece fills.
@@ -125,6 +140,11 @@ impl fmt::Display for Failure {
             Failure::NotPlaceable { piece, step } => write!(
                 f,
                 "piece #{piece} (step {}) cannot be put in place: earlier pieces enclose it",
+                step.0
+            ),
+            Failure::Enclosed { piece, step } => write!(
+                f,
+                "piece #{piece} (step {}) is placed inside a closed cavity: earlier pieces shut it in on every side",
                 step.0
             ),
             Failure::CoverMismatch {
@@ -220,6 +240,23 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
         }
         occupied.add(b);
     }
+    // One failure a piece: one that cannot move at all is not also shut in.
+    let stuck: HashSet<usize> = failures
+        .iter()
+        .filter_map(|f| match f {
+            Failure::Overlap { b, .. } => Some(*b),
+            Failure::NotPlaceable { piece, .. } => Some(*piece),
+            _ => None,
+        })
+        .collect();
+    failures.extend(
+        enclosed(&boxes, &stuck)
+            .into_iter()
+            .map(|i| Failure::Enclosed {
+                piece: i,
+                step: steps[i],
+            }),
+    );
 
     let components = count_components(&neighbours);
     if components > 1 {
@@ -394,6 +431,121 @@ impl Occupied {
     }
 }
 
+/// The pieces (but those in `skip`) whose box, at their turn,
+/// no path of free cells joins to the space around the build.
+///
+/// Taken in reverse build order, the free space only grows: each piece
+/// taken away frees its cells, and a flood from the outside spreads into
+/// them when they touch it. Every cell is flooded once, so the check costs
+/// the build's bounding box and the pieces' boxes, not their product.
+fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
+    let Some(first) = boxes.first() else {
+        return Vec::new();
+    };
+    let (mut lo, mut hi) = (first.min, first.max_excl());
+    for b in boxes {
+        let m = b.max_excl();
+        lo = Cell::new(lo.x.min(b.min.x), lo.y.min(b.min.y), lo.z.min(b.min.z));
+        hi = Cell::new(hi.x.max(m.x), hi.y.max(m.y), hi.z.max(m.z));
+    }
+    // One free cell around the sides and over the top; none under the
+    // lowest layer (the table).
+    let origin = lo.offset(-1, -1, 0);
+    let (nx, ny, nz) = (hi.x - lo.x + 2, hi.y - lo.y + 2, hi.z - lo.z + 1);
+    let index = |c: Cell| {
+        let (x, y, z) = (c.x - origin.x, c.y - origin.y, c.z - origin.z);
+        (x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz)
+            .then(|| ((z * ny + y) * nx + x) as usize)
+    };
+    let border = |c: Cell| {
+        c.x == origin.x
+            || c.y == origin.y
+            || c.x == origin.x + nx - 1
+            || c.y == origin.y + ny - 1
+            || c.z == origin.z + nz - 1
+    };
+    let mut taken = vec![0u32; (nx * ny * nz) as usize];
+    for b in boxes {
+        for c in b.cells() {
+            if let Some(i) = index(c) {
+                taken[i] += 1;
+            }
+        }
+    }
+    let mut outside = vec![false; taken.len()];
+    let mut queue: Vec<Cell> = Vec::new();
+    let flood = |queue: &mut Vec<Cell>, outside: &mut Vec<bool>, taken: &[u32]| {
+        while let Some(c) = queue.pop() {
+            for (dx, dy, dz) in [
+                (1, 0, 0),
+                (-1, 0, 0),
+                (0, 1, 0),
+                (0, -1, 0),
+                (0, 0, 1),
+                (0, 0, -1),
+            ] {
+                let n = c.offset(dx, dy, dz);
+                if let Some(i) = index(n) {
+                    if taken[i] == 0 && !outside[i] {
+                        outside[i] = true;
+                        queue.push(n);
+                    }
+                }
+            }
+        }
+    };
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = origin.offset(x, y, z);
+                if border(c) {
+                    if let Some(i) = index(c) {
+                        outside[i] = true;
+                        queue.push(c);
+                    }
+                }
+            }
+        }
+    }
+    flood(&mut queue, &mut outside, &taken);
+    let mut shut = Vec::new();
+    for (k, b) in boxes.iter().enumerate().rev() {
+        for c in b.cells() {
+            if let Some(i) = index(c) {
+                taken[i] -= 1;
+            }
+        }
+        // Freed cells beside the outside join it, and so does what they
+        // open onto.
+        for c in b.cells() {
+            let Some(i) = index(c) else { continue };
+            if taken[i] > 0 || outside[i] {
+                continue;
+            }
+            let touches = [
+                (1, 0, 0),
+                (-1, 0, 0),
+                (0, 1, 0),
+                (0, -1, 0),
+                (0, 0, 1),
+                (0, 0, -1),
+            ]
+            .iter()
+            .any(|&(dx, dy, dz)| index(c.offset(dx, dy, dz)).is_some_and(|j| outside[j]));
+            if touches {
+                outside[i] = true;
+                queue.push(c);
+                flood(&mut queue, &mut outside, &taken);
+            }
+        }
+        if !skip.contains(&k) && !b.cells().any(|c| index(c).is_some_and(|i| outside[i])) {
+            shut.push(k);
+        }
+    }
+    shut.reverse();
+    shut
+}
+
 /// The box `b` moved to minimum corner `min`.
 fn moved(b: &CellBox, min: Cell) -> CellBox {
     CellBox { min, ..*b }
@@ -523,6 +675,70 @@ mod tests {
                 _ => None,
             })
             .collect()
+    }
+
+    /// A ring of 2 x 2 bricks on the ground round a 2 x 2 hole, closed by a
+    /// lid of two courses of 2 x 6 bricks; `inner` is a 2 x 2 brick in the
+    /// hole, put in before the lid or after it.
+    fn closed_box(inner_first: bool) -> Assembly {
+        let ring = [
+            (0, 0),
+            (2, 0),
+            (4, 0),
+            (0, 2),
+            (4, 2),
+            (0, 4),
+            (2, 4),
+            (4, 4),
+        ];
+        let mut pieces: Vec<(&str, i32, i32, i32, Rot)> =
+            ring.iter().map(|&(x, y)| ("3003", x, y, 0, R0)).collect();
+        let inner = ("3003", 2, 2, 0, R0);
+        if inner_first {
+            pieces.push(inner);
+        }
+        pieces.extend([0, 2, 4].map(|y| ("2456", 0, y, 1, R0)));
+        // Across the lid, holding its rows together.
+        pieces.extend([0, 2, 4].map(|x| ("2456", x, 0, 2, R90)));
+        if !inner_first {
+            pieces.push(inner);
+        }
+        build(&pieces)
+    }
+
+    #[test]
+    fn a_piece_inside_a_closed_cavity_is_refused() {
+        // The lid first: the piece in the hole is shut in (the table under
+        // it is no way in, though nothing stands between it and the ground).
+        let late = verify(&closed_box(false), None);
+        assert_eq!(
+            late.failures,
+            vec![Failure::Enclosed {
+                piece: 14,
+                step: Step(15)
+            }],
+            "{late}"
+        );
+        assert!(
+            late.to_string().contains("inside a closed cavity"),
+            "{late}"
+        );
+        // The same piece before the lid: built while the box is open.
+        let early = verify(&closed_box(true), None);
+        assert!(early.is_ok(), "{early}");
+    }
+
+    #[test]
+    fn the_last_piece_closing_a_cavity_goes_in_from_outside() {
+        // A lid piece goes into the last gap from above; a piece under an
+        // overhang comes in from the side.
+        let asm = build(&[
+            ("3003", 0, 0, 0, R0),
+            ("3003", 4, 0, 0, R0),
+            ("2456", 0, 0, 1, R0),
+            ("3003", 2, 0, 0, R0),
+        ]);
+        assert!(verify(&asm, None).is_ok());
     }
 
     #[test]

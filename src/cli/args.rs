@@ -247,6 +247,13 @@ pub struct BuildArgs {
     /// pieces (for a model to be built on a baseplate, say).
     #[arg(long)]
     pub no_supports: bool,
+    /// Build a hollow shell (walls --wall thick, inner pillars where the roof needs them)
+    /// instead of a solid model: a fraction of the pieces.
+    #[arg(long)]
+    pub hollow: bool,
+    /// With --hollow, the shell's thickness: studs across, courses up and down (1 to 16).
+    #[arg(long, value_name = "N", default_value_t = 2, requires = "hollow", value_parser = clap::value_parser!(u32).range(1..=brickwright::voxel::hollow::MAX_WALL as i64))]
+    pub wall: u32,
     /// Give up the search after this many seconds.
     #[arg(long, default_value_t = 300.0)]
     pub time_budget: f64,
@@ -317,7 +324,8 @@ impl BuildArgs {
             .search
             .with_seed(a.seed)
             .with_time_budget(time_budget)
-            .with_complex_every(a.complex_every);
+            .with_complex_every(a.complex_every)
+            .with_hollow(brickwright::voxel::Wall::new(a.wall).filter(|_| a.hollow));
         Ok(opts)
     }
 }

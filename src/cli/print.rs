@@ -62,6 +62,13 @@ pub fn build_summary(r: &BuildReport, out_dir: &Path) {
                 rep.joined_islands, rep.support_voxels, rep.thickened_voxels, rep.evened_voxels, rep.extra_cells
             );
     }
+    if let Some(h) = &r.hollow {
+        outln!(
+            "  hollow: walls {} thick, {} pieces ({} inside as pillars) and {:.0} g where the solid build takes {} pieces and {:.0} g ({:.0}% of its pieces, {:.0}% of its mass)",
+            h.wall, h.hollow.pieces, h.inner_pieces, h.hollow.mass_g, h.solid.pieces, h.solid.mass_g,
+            100.0 * h.pieces_share, 100.0 * h.mass_share
+        );
+    }
     let q = &r.quality;
     outln!(
             "  quality: {} voxels left out, {:.0}% of seams continued, {:.1} voxels a piece, {:.0}% 1x1s, {} studs across (asked {})",

@@ -243,7 +243,9 @@ fn unplaceable(asm: &Assembly, placed: &[Placement], chosen: &[Candidate]) -> Ve
             Failure::Overlap { a, b, .. } => {
                 out.extend([a, b].into_iter().filter_map(column_of).map(Candidate::key));
             }
-            Failure::NotPlaceable { piece, .. } | Failure::NotConnected { piece, .. } => {
+            Failure::NotPlaceable { piece, .. }
+            | Failure::Enclosed { piece, .. }
+            | Failure::NotConnected { piece, .. } => {
                 if let Some(c) = column_of(piece) {
                     out.push(c.key());
                     continue;

@@ -13,6 +13,7 @@
 use std::time::Instant;
 
 mod error;
+pub mod hollow;
 mod input;
 mod options;
 pub mod pictures;
@@ -108,6 +109,17 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         })?,
     };
 
+    // A hollow build is set beside the solid one it replaces, laid out too.
+    let hollow = match opts.search.hollow {
+        Some(_) => stage(
+            progress,
+            "laying out the solid build",
+            &mut times.search,
+            || planner.solid_report(&settled),
+        )?,
+        None => None,
+    };
+
     let stem = opts.stem();
     let pictures = pictures::Pictures::of(&settled, &stem, setup.rules.layer_ldu());
     let rendered = match pictures::wanted(&opts.formats) {
@@ -126,7 +138,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         _ => None,
     };
 
-    let report = report::compose(opts, &mesh, &model, &setup, &settled, times);
+    let report = report::compose(opts, &mesh, &model, &setup, &settled, hollow, times);
     progress.stage("writing");
     let report = write::write(
         opts,

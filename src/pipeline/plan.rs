@@ -81,6 +81,33 @@ impl<'a> Planner<'a> {
         Ok(first)
     }
 
+    /// With `--hollow`, the hollow build `settled` beside the solid build it
+    /// replaces, laid out by the same search with the same seed.
+    pub(super) fn solid_report(
+        &self,
+        settled: &super::stability::Settled,
+    ) -> Result<Option<super::hollow::HollowReport>, BuildError> {
+        let model = &self.voxels.model;
+        let guide = search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+            colors: self.voxels.labels.as_deref(),
+            progress: None,
+        };
+        super::hollow::report(
+            &settled.assembly,
+            &settled.outcome,
+            &model.grid,
+            guide,
+            self.rules,
+            &self.opts.search,
+        )
+        .map_err(|reason| BuildError::Search {
+            file: self.file.clone(),
+            reason,
+        })
+    }
+
     /// A verified, grouped build from the layout with `seed`.
     pub(super) fn plan(&self, seed: u64) -> Result<Plan, BuildError> {
         self.plan_told(seed, false)

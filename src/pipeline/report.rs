@@ -95,6 +95,10 @@ pub struct BuildReport {
     /// LDraw colours of the build that have no known BrickLink or
     /// Rebrickable id (their parts-list lines say so).
     pub unmapped_colors: Vec<u16>,
+    /// A hollow build's size beside the solid build it replaces; absent
+    /// for a solid build.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hollow: Option<super::hollow::HollowReport>,
     /// Connected components of the finished build (1 when verified).
     pub components: usize,
     /// Steps in the outputs.
@@ -250,7 +254,8 @@ pub(super) fn mesh_color_report(
 }
 
 /// The report of a settled build of `mesh`, its voxels `voxels`, made
-/// with `setup`'s rules, the stages having taken `times` (the outputs and
+/// with `setup`'s rules (`hollow`: beside the solid build), the stages
+/// having taken `times` (the outputs and
 /// the write time are filled in when they are written).
 pub(super) fn compose(
     opts: &BuildOptions,
@@ -258,6 +263,7 @@ pub(super) fn compose(
     voxels: &Voxels,
     setup: &Setup,
     settled: &Settled,
+    hollow: Option<super::hollow::HollowReport>,
     times: StageTimes,
 ) -> BuildReport {
     let assembly = &settled.assembly;
@@ -290,6 +296,7 @@ pub(super) fn compose(
             .as_ref()
             .map(|c| mesh_color_report(assembly, &voxels.model.grid, c)),
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
+        hollow,
         components: crate::assembly::verify::components(assembly),
         steps: assembly.step_count(),
         booklet_pages: opts

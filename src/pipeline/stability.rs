@@ -716,12 +716,15 @@ impl Settled {
     }
 
     /// What the booklet and the `.ldr` say of a step that adds a support
-    /// column.
+    /// column or, in a hollow build, an inner pillar.
     pub(super) fn step_notes(&self) -> std::collections::BTreeMap<u32, String> {
         self.stability
             .iter()
             .flat_map(|(r, _)| &r.supports)
-            .map(|c| (c.step, crate::pipeline::SUPPORT_NOTE.to_string()))
+            .map(|c| {
+                let note = super::hollow::note(c, self.outcome.emptied.as_ref());
+                (c.step, note.to_string())
+            })
             .collect()
     }
 

@@ -368,7 +368,7 @@ impl Layout<'_> {
         let body = s.body_at(origin);
         let mut extra = 0;
         for q in body.cells() {
-            if !self.must.in_bounds(q) {
+            if !self.must.in_bounds(q) || self.kept_empty(q) {
                 return;
             }
             match self.owner_of(q) {

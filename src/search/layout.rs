@@ -220,6 +220,8 @@ pub(crate) struct Layout<'a> {
     /// Empty cells the surface passes through.
     pub near: VoxelGrid,
     pub slant: Option<&'a Slant>,
+    /// Cells no piece may fill: the inside of a hollow build.
+    pub keep_empty: Option<&'a VoxelGrid>,
     /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
@@ -325,6 +327,7 @@ impl<'a> Layout<'a> {
             must,
             near,
             slant,
+            keep_empty: None,
             colors: None,
             made,
             shapes,
@@ -351,7 +354,12 @@ impl<'a> Layout<'a> {
     }
 
     fn free(&self, c: Cell) -> bool {
-        self.must.in_bounds(c) && self.owner[self.must.index(c)] == NONE
+        self.must.in_bounds(c) && self.owner[self.must.index(c)] == NONE && !self.kept_empty(c)
+    }
+
+    /// Whether `c` must stay empty (the inside of a hollow build).
+    pub fn kept_empty(&self, c: Cell) -> bool {
+        self.keep_empty.is_some_and(|k| k.get(c))
     }
 
     /// Lays every layer, bottom first, until done or `deadline`.

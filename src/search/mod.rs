@@ -43,7 +43,7 @@ use thiserror::Error;
 
 use crate::assembly::Placement;
 use crate::grammar::{RuleRef, RuleSet};
-use crate::voxel::{Slant, VoxelGrid};
+use crate::voxel::{Slant, VoxelGrid, Wall};
 pub use prepare::{components, LeftOut, Repairs};
 
 /// The most voxels a model may have: some 400,000 bricks.
@@ -62,6 +62,9 @@ pub struct SearchOptions {
     /// scored basic rules (paper, section 4: "once every fifth node to
     /// once every node", so 5 to 1). 0, the default, never tries them.
     pub complex_every: u32,
+    /// Build a shell with walls this thick and the inside empty (see
+    /// [`crate::voxel::hollow`]); `None`, the default, builds solid.
+    pub hollow: Option<Wall>,
 }
 
 impl Default for SearchOptions {
@@ -70,6 +73,7 @@ impl Default for SearchOptions {
             seed: 1,
             time_budget: Duration::from_secs(300),
             complex_every: 0,
+            hollow: None,
         }
     }
 }
@@ -84,6 +88,12 @@ impl SearchOptions {
     /// Sets the time budget.
     pub fn with_time_budget(mut self, t: Duration) -> Self {
         self.time_budget = t;
+        self
+    }
+
+    /// Builds hollow with walls `wall` thick (`None`: solid).
+    pub fn with_hollow(mut self, wall: Option<Wall>) -> Self {
+        self.hollow = wall;
         self
     }
 
@@ -202,6 +212,9 @@ pub struct SearchOutcome {
     pub voxels: VoxelGrid,
     /// What the repairs changed.
     pub repairs: Repairs,
+    /// In a hollow build, the cells of the model left empty inside its
+    /// shell; `None` for a solid build.
+    pub emptied: Option<VoxelGrid>,
     /// Counters.
     pub stats: SearchStats,
 }
@@ -276,10 +289,18 @@ pub fn build_guided(
     if !plates {
         prepare::even_courses(&mut fixed, guide.slant, course, &mut repairs);
     }
+    // The shell is taken of the repaired voxels, so that thickened sheets
+    // and joined islands are measured as the model they are.
+    let emptied = opts.hollow.map(|wall| {
+        let h = crate::voxel::hollow(&fixed, wall, course, min_thick);
+        fixed = h.shell;
+        h.emptied
+    });
 
     let mut layout = layout::Layout::new(rules, &fixed, guide.surface, guide.slant);
     layout.repairs = repairs;
     layout.colors = guide.colors.filter(|c| c.len() == fixed.len());
+    layout.keep_empty = emptied.as_ref();
     let mut dice = Dice::new(opts.seed);
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
@@ -338,6 +359,7 @@ pub fn build_guided(
         order,
         voxels: target,
         repairs: layout.repairs,
+        emptied,
         stats,
     })
 }
@@ -353,7 +375,8 @@ fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<Placement> {
         .failures
         .iter()
         .filter_map(|f| match f {
-            crate::assembly::verify::Failure::NotPlaceable { piece, .. } => Some(pieces[*piece]),
+            crate::assembly::verify::Failure::NotPlaceable { piece, .. }
+            | crate::assembly::verify::Failure::Enclosed { piece, .. } => Some(pieces[*piece]),
             _ => None,
         })
         .collect()

@@ -12,3 +12,5 @@ pub use voxelize::{
 pub mod colour;
 pub mod smooth;
 pub use colour::{color_voxels, VoxelColors};
+pub mod hollow;
+pub use hollow::{hollow, Hollowed, Wall};

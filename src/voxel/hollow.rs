@@ -1,0 +1,263 @@
+//! Hollow models: a shell of the voxels near the outside, the rest left
+//! empty.
+//!
+//! A solid build spends most of its pieces where no one sees them. Builders
+//! of big models build a shell instead, and so does [`hollow`]: a voxel is
+//! kept when an outside cell lies within the wall's thickness of it, in its
+//! own layer (`wall` studs, chessboard distance, so a wall is as thick along
+//! a diagonal as along an axis) or in its own column (`wall` courses up or
+//! down). Everything else is emptied, and those cells must stay empty: the
+//! layout never fills them.
+//!
+//! - Thin parts stay solid: each of their voxels is near the outside.
+//! - The ground is not the outside: a model standing on the table has no
+//!   floor over it, as a person builds a big hollow model (the table is the
+//!   floor, and the shell is closed all the same).
+//! - A lid over the hollow is at least as thick as the thinnest sheet that
+//!   holds together (two courses of bricks side by side do, one does not).
+//! - Pockets narrower than [`MIN_HOLE`] studs are filled again: a slot
+//!   under a ridge costs more pieces, short ones bridging it, than it
+//!   saves.
+//!
+//! What holds a lid or a roof over the hollow is decided later, by the
+//! stability stage, which adds inner pillars where the statics need them.
+//!
+//! ```
+//! use brickwright::voxel::{hollow, VoxelGrid, Wall};
+//! use brickwright::geom::{Cell, CellBox};
+//!
+//! let mut solid = VoxelGrid::new(10, 10, 10);
+//! let all = CellBox { min: Cell::new(0, 0, 0), sx: 10, sy: 10, sz: 10 };
+//! solid.set_box(&all, true);
+//! let h = hollow(&solid, Wall::new(2).unwrap(), 1, 2);
+//! // 6 x 6 studs inside the walls, from the ground to under the 2-course lid.
+//! assert_eq!(h.emptied.count(), 6 * 6 * 8);
+//! assert_eq!(h.shell.count() + h.emptied.count(), 1000);
+//! ```
+
+use serde::Serialize;
+
+use super::VoxelGrid;
+use crate::geom::Cell;
+
+/// The narrowest hollow, in studs both ways: a narrower pocket is filled
+/// again, as a slot under a ridge or between two walls costs more pieces
+/// (short ones, bridging it) than it saves.
+pub const MIN_HOLE: i32 = 4;
+
+/// The thickest wall `--wall` takes, in studs.
+pub const MAX_WALL: u32 = 16;
+
+/// A shell's wall thickness: studs horizontally, courses vertically.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Wall(u32);
+
+impl Wall {
+    /// The default, two studs: the wall bricks overlap across its
+    /// thickness, and a lid of two courses holds together.
+    pub const DEFAULT: Wall = Wall(2);
+
+    /// A wall `n` studs thick, 1 to [`MAX_WALL`].
+    pub fn new(n: u32) -> Option<Wall> {
+        (1..=MAX_WALL).contains(&n).then_some(Wall(n))
+    }
+
+    /// Its thickness in studs (and in courses).
+    pub fn studs(self) -> u32 {
+        self.0
+    }
+}
+
+impl Default for Wall {
+    fn default() -> Self {
+        Wall::DEFAULT
+    }
+}
+
+/// A hollowed model.
+#[derive(Debug, Clone)]
+pub struct Hollowed {
+    /// The voxels kept: the shell.
+    pub shell: VoxelGrid,
+    /// The voxels emptied: no piece may fill them.
+    pub emptied: VoxelGrid,
+}
+
+/// The shell of `solid` with walls `wall` thick: `course` layers make a
+/// course, and a lid over the hollow is at least `min_lid` layers thick.
+pub fn hollow(solid: &VoxelGrid, wall: Wall, course: i32, min_lid: i32) -> Hollowed {
+    let (nx, ny, nz) = solid.dims();
+    let n = wall.studs() as i32;
+    let up = (n * course.max(1)).max(min_lid);
+    let across = horizontal_depth(solid);
+    let mut inner = VoxelGrid::new(nx, ny, nz);
+    for c in solid.cells() {
+        if across[solid.index(c)] > n && deep_in_column(solid, c, up) {
+            inner.set(c, true);
+        }
+    }
+    let emptied = open_square(&inner);
+    let mut shell = solid.clone();
+    for c in emptied.cells() {
+        shell.set(c, false);
+    }
+    Hollowed { shell, emptied }
+}
+
+/// Per cell (by [`VoxelGrid::index`]): the chessboard distance, within its
+/// layer, to the nearest cell outside `g` (off the grid counts as outside);
+/// 0 for cells outside. Two passes of the classic chamfer transform, exact
+/// for this metric.
+fn horizontal_depth(g: &VoxelGrid) -> Vec<i32> {
+    let (nx, ny, nz) = g.dims();
+    let mut d = vec![0i32; g.len()];
+    let at = |x: i32, y: i32, z: i32| g.index(Cell::new(x, y, z));
+    for z in 0..nz {
+        // Off the grid, the distance is 0: a border cell is 1 deep.
+        let get = |d: &[i32], x: i32, y: i32| {
+            if x < 0 || y < 0 || x >= nx || y >= ny {
+                0
+            } else {
+                d[at(x, y, z)]
+            }
+        };
+        for y in 0..ny {
+            for x in 0..nx {
+                if !g.get(Cell::new(x, y, z)) {
+                    continue;
+                }
+                let m = [(-1, 0), (-1, -1), (0, -1), (1, -1)]
+                    .iter()
+                    .map(|&(dx, dy)| get(&d, x + dx, y + dy))
+                    .min()
+                    .unwrap_or(0);
+                d[at(x, y, z)] = m + 1;
+            }
+        }
+        for y in (0..ny).rev() {
+            for x in (0..nx).rev() {
+                if !g.get(Cell::new(x, y, z)) {
+                    continue;
+                }
+                let m = [(1, 0), (1, 1), (0, 1), (-1, 1)]
+                    .iter()
+                    .map(|&(dx, dy)| get(&d, x + dx, y + dy) + 1)
+                    .min()
+                    .unwrap_or(i32::MAX);
+                let i = at(x, y, z);
+                d[i] = d[i].min(m);
+            }
+        }
+    }
+    d
+}
+
+/// Whether the `up` cells above `c` and the `up` cells below it (down to
+/// the ground, which is no outside) are all in `g`; above the grid is
+/// outside.
+fn deep_in_column(g: &VoxelGrid, c: Cell, up: i32) -> bool {
+    let (_, _, nz) = g.dims();
+    (1..=up).all(|k| c.z + k < nz && g.get(c.offset(0, 0, k)))
+        && (1..=up).all(|k| c.z - k < 0 || g.get(c.offset(0, 0, -k)))
+}
+
+/// The cells of `g` that lie in a [`MIN_HOLE`]-wide square of its cells
+/// in their layer.
+fn open_square(g: &VoxelGrid) -> VoxelGrid {
+    let (nx, ny, nz) = g.dims();
+    let k = MIN_HOLE;
+    // Per cell, the side of the biggest square of cells whose corner of
+    // highest x and y it is (dynamic programming over the layer).
+    let mut side = vec![0i32; g.len()];
+    let mut out = VoxelGrid::new(nx, ny, nz);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = Cell::new(x, y, z);
+                if !g.get(c) {
+                    continue;
+                }
+                let at = |dx: i32, dy: i32| {
+                    let q = c.offset(dx, dy, 0);
+                    if q.x < 0 || q.y < 0 {
+                        0
+                    } else {
+                        side[g.index(q)]
+                    }
+                };
+                let s = 1 + at(-1, 0).min(at(0, -1)).min(at(-1, -1));
+                side[g.index(c)] = s;
+                if s >= k {
+                    for dy in 0..k {
+                        for dx in 0..k {
+                            out.set(c.offset(-dx, -dy, 0), true);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::CellBox;
+
+    fn block(nx: i32, ny: i32, nz: i32) -> VoxelGrid {
+        let mut g = VoxelGrid::new(nx, ny, nz);
+        let all = CellBox {
+            min: Cell::new(0, 0, 0),
+            sx: nx,
+            sy: ny,
+            sz: nz,
+        };
+        g.set_box(&all, true);
+        g
+    }
+
+    #[test]
+    fn a_block_keeps_walls_as_thick_as_asked_and_no_floor() {
+        for n in [1, 2, 3] {
+            let g = block(14, 11, 10);
+            let h = hollow(&g, Wall::new(n).unwrap(), 1, 2);
+            let lid = (n as i32).max(2);
+            for c in g.cells() {
+                let edge = c.x.min(c.y).min(13 - c.x).min(10 - c.y);
+                let inside = edge >= n as i32 && c.z < 10 - lid;
+                assert_eq!(h.emptied.get(c), inside, "wall {n}, cell {c:?}");
+                assert_eq!(h.shell.get(c), !inside);
+            }
+        }
+    }
+
+    #[test]
+    fn lids_are_measured_in_courses() {
+        // Three layers a course (plates): a 2-course lid is 6 layers.
+        let h = hollow(&block(10, 10, 12), Wall::DEFAULT, 3, 2);
+        let c = Cell::new(5, 5, 0);
+        let top = (0..12).filter(|&z| h.emptied.get(c.offset(0, 0, z))).max();
+        assert_eq!(top, Some(5));
+    }
+
+    #[test]
+    fn thin_parts_stay_solid_and_narrow_pockets_are_filled_again() {
+        // A slab 4 studs deep: every voxel within 2 of the outside.
+        let thin = block(20, 4, 8);
+        assert_eq!(hollow(&thin, Wall::DEFAULT, 1, 2).shell, thin);
+        // 7 deep: a pocket 3 studs wide inside, too narrow to keep.
+        let narrow = block(20, 7, 8);
+        assert!(hollow(&narrow, Wall::DEFAULT, 1, 2).emptied.is_empty());
+        // 8 deep: a pocket 4 studs wide, kept.
+        let wide = hollow(&block(20, 8, 8), Wall::DEFAULT, 1, 2);
+        assert_eq!(wide.emptied.count(), 16 * 4 * 6);
+    }
+
+    #[test]
+    fn wall_thickness_is_validated() {
+        assert!(Wall::new(0).is_none());
+        assert!(Wall::new(MAX_WALL + 1).is_none());
+        assert_eq!(Wall::new(1).map(Wall::studs), Some(1));
+    }
+}

@@ -1,0 +1,283 @@
+//! Hollow builds on the fixtures: the box's inside is empty and its walls
+//! as thick as asked, its lid holds; the house keeps its roof, and at 32
+//! studs inner pillars hold it up, built before the roof closes; every
+//! step stands, `verify` passes, and the report measures the solid build
+//! the hollow one replaces.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use brickwright::assembly::verify::{verify, Failure};
+use brickwright::assembly::{Assembly, Placed, Placement, Step};
+use brickwright::catalog::PartKind;
+use brickwright::geom::{Cell, Rot};
+use brickwright::pipeline::{self, BuildOptions, BuildOutput, Formats, Silent, Stability};
+use brickwright::voxel::{voxelize, Sizing, VoxelGrid, VoxelizeOptions, Wall};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name)
+}
+
+/// Builds fixture `name` at `studs` into `out`, hollow with walls `wall`
+/// thick (`None`: solid).
+fn build(name: &str, studs: u32, wall: Option<u32>, out: &Path) -> BuildOutput {
+    let mut opts = BuildOptions::new(fixture(name));
+    opts.out_dir = out.to_path_buf();
+    opts.sizing = Sizing::Studs(studs);
+    opts.formats = Formats::parse("ldr").unwrap();
+    opts.search = opts
+        .search
+        .clone()
+        .with_hollow(wall.map(|w| Wall::new(w).unwrap()));
+    pipeline::build(&opts, &Silent).unwrap()
+}
+
+/// The fixture's voxels, as the build sees them.
+fn solid(name: &str, studs: u32) -> VoxelGrid {
+    let mesh = brickwright::mesh::load(&fixture(name)).unwrap();
+    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
+    voxelize(&mesh, &opts).unwrap().grid
+}
+
+/// The cells the pieces fill.
+fn filled(asm: &Assembly, dims: (i32, i32, i32)) -> VoxelGrid {
+    let mut g = VoxelGrid::new(dims.0, dims.1, dims.2);
+    for p in &asm.pieces {
+        g.set_body(&p.placement.body(asm.layer_ldu), true);
+    }
+    g
+}
+
+/// `brickwright verify --stability FILE` passes.
+fn verified_with_stability(ldr: &Path) {
+    let run = Command::new(env!("CARGO_BIN_EXE_brickwright"))
+        .args(["verify", "--stability", ldr.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+#[test]
+fn the_hollow_box_is_empty_inside_with_walls_as_thick_as_asked_and_its_lid_holds() {
+    let model = solid("box.obj", 24);
+    let (nx, ny, nz) = model.dims();
+    assert_eq!(model.count() as i32, nx * ny * nz, "the box fills its grid");
+    for wall in [1, 2] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = build("box.obj", 24, Some(wall), tmp.path());
+        let cells = filled(&out.assembly, model.dims());
+        // Walls `wall` studs thick, a lid of two courses (one course of
+        // bricks side by side does not hold together), no floor on the
+        // table; nothing else.
+        let lid = wall.max(2) as i32;
+        let w = wall as i32;
+        for c in model.cells() {
+            let inside = c.x >= w && c.x < nx - w && c.y >= w && c.y < ny - w && c.z < nz - lid;
+            assert_eq!(cells.get(c), !inside, "wall {wall}: cell {c:?}");
+        }
+        let r = &out.report;
+        let h = r.hollow.as_ref().expect("a hollow section");
+        assert_eq!(h.wall, wall);
+        assert_eq!(h.inner_pieces, 0, "the lid spans the box without pillars");
+        assert_eq!(
+            h.emptied_voxels as i32,
+            (nx - 2 * w) * (ny - 2 * w) * (nz - lid)
+        );
+        assert_eq!(h.hollow.pieces, out.assembly.pieces.len());
+        assert!(h.hollow.pieces < h.solid.pieces, "{h:?}");
+        assert!(h.mass_share < 0.6, "{h:?}");
+        // The lid holds at every step, and any checker agrees.
+        let st = r.stability.as_ref().unwrap();
+        assert!(st.stands && st.first_failure.is_none(), "{st:?}");
+        assert!(verify(&out.assembly, None).is_ok());
+        verified_with_stability(&tmp.path().join("box.ldr"));
+    }
+}
+
+#[test]
+fn the_report_measures_the_solid_build_it_replaces() {
+    let tmp = tempfile::tempdir().unwrap();
+    let hollow = build("box.obj", 24, Some(2), &tmp.path().join("hollow"));
+    let mut opts = BuildOptions::new(fixture("box.obj"));
+    opts.out_dir = tmp.path().join("solid");
+    opts.sizing = Sizing::Studs(24);
+    opts.formats = Formats::parse("ldr").unwrap();
+    opts.stability = Stability::Off;
+    let solid_run = pipeline::build(&opts, &Silent).unwrap();
+    let h = hollow.report.hollow.unwrap();
+    // The same layout, laid out for real: its pieces and mass.
+    assert_eq!(h.solid.pieces, solid_run.assembly.pieces.len());
+    let mass: f64 = solid_run
+        .assembly
+        .pieces
+        .iter()
+        .map(|p| f64::from(p.placement.part.spec().mass_g))
+        .sum();
+    assert!(
+        (h.solid.mass_g - mass).abs() < 0.1,
+        "{} vs {mass}",
+        h.solid.mass_g
+    );
+    assert!((h.solid.filled_share - 1.0).abs() < 1e-9);
+    let model = solid("box.obj", 24).count() as f64;
+    let shell = filled(&hollow.assembly, (24, 12, 15)).count() as f64;
+    assert!(
+        (h.hollow.filled_share - shell / model).abs() < 1e-4,
+        "{h:?}"
+    );
+    assert!(h.mass_share < 0.6 && h.pieces_share < 0.6, "{h:?}");
+    // report.json says the same.
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(tmp.path().join("hollow/report.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(json["hollow"]["solid"]["pieces"], h.solid.pieces);
+    assert_eq!(json["hollow"]["hollow"]["pieces"], h.hollow.pieces);
+    assert_eq!(json["pieces"], h.hollow.pieces);
+}
+
+/// The top voxel of every column of `model` is filled in `cells`.
+fn roof_kept(model: &VoxelGrid, cells: &VoxelGrid) {
+    let (nx, ny, nz) = model.dims();
+    for y in 0..ny {
+        for x in 0..nx {
+            if let Some(z) = (0..nz).rev().find(|&z| model.get(Cell::new(x, y, z))) {
+                assert!(cells.get(Cell::new(x, y, z)), "roof at ({x}, {y}, {z})");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_hollow_house_keeps_its_roof() {
+    let tmp = tempfile::tempdir().unwrap();
+    let model = solid("house.obj", 24);
+    let out = build("house.obj", 24, Some(2), tmp.path());
+    let cells = filled(&out.assembly, model.dims());
+    roof_kept(&model, &cells);
+    let h = out.report.hollow.as_ref().unwrap();
+    assert!(h.emptied_voxels * 2 > model.count(), "{h:?}");
+    let st = out.report.stability.as_ref().unwrap();
+    assert!(st.stands, "{st:?}");
+    verified_with_stability(&tmp.path().join("house.ldr"));
+}
+
+#[test]
+fn at_32_studs_inner_pillars_hold_the_house_roof_and_go_in_before_it_closes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let model = solid("house.obj", 32);
+    let out = build("house.obj", 32, Some(2), tmp.path());
+    let cells = filled(&out.assembly, model.dims());
+    roof_kept(&model, &cells);
+    let r = &out.report;
+    let h = r.hollow.as_ref().unwrap();
+    // The target: at most 40% of the solid build's pieces.
+    assert!(h.pieces_share <= 0.40, "{h:?}");
+    // The stability stage put pillars in the hollow, and the build stands.
+    let st = r.stability.as_ref().unwrap();
+    assert!(st.stands, "{st:?}");
+    assert!(
+        h.inner_pieces > 0 && h.inner_pieces == st.support_pieces,
+        "{h:?}"
+    );
+    let ldr = std::fs::read_to_string(tmp.path().join("house.ldr")).unwrap();
+    assert!(
+        ldr.contains(&format!("0 // {}", pipeline::hollow::PILLAR_NOTE)),
+        "{ldr}"
+    );
+    verified_with_stability(&tmp.path().join("house.ldr"));
+    // The pillars' pieces put in last, after the roof closed over them,
+    // are refused: they would be inside a closed cavity.
+    let inside = |c: Cell| {
+        st.supports.iter().any(|col| {
+            (col.x..col.x + col.size[0]).contains(&c.x)
+                && (col.y..col.y + col.size[1]).contains(&c.y)
+                && (col.bottom..=col.top).contains(&c.z)
+        })
+    };
+    let pillar: Vec<Placed> = out
+        .assembly
+        .pieces
+        .iter()
+        .filter(|p| p.placement.body(out.assembly.layer_ldu).cells().all(inside))
+        .cloned()
+        .collect();
+    assert_eq!(pillar.len(), st.support_pieces);
+    assert!(!pillar.is_empty());
+    let mut late = out.assembly.clone();
+    late.pieces.retain(|p| !pillar.contains(p));
+    let last = late.pieces.last().unwrap().step.0;
+    late.pieces.extend(pillar.iter().map(|p| Placed {
+        step: Step(last + 1),
+        ..*p
+    }));
+    let report = verify(&late, None);
+    assert!(
+        report
+            .failures
+            .iter()
+            .any(|f| matches!(f, Failure::Enclosed { .. })),
+        "{report}"
+    );
+}
+
+#[test]
+fn a_piece_put_in_the_closed_box_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = build("box.obj", 24, Some(2), tmp.path());
+    let mut asm = out.assembly.clone();
+    // A 2 x 2 brick on the table in the middle of the box, after the lid.
+    let inner = Placement::new(
+        PartKind::from_id("3003").unwrap(),
+        Cell::new(11, 5, 0),
+        Rot::R0,
+    );
+    let step = Step(asm.pieces.last().unwrap().step.0 + 1);
+    asm.pieces.push(Placed {
+        placement: inner,
+        step,
+        color: asm.pieces[0].color,
+    });
+    // Shut in (and, on its own, joined to nothing).
+    let report = verify(&asm, None);
+    let shut: Vec<&Failure> = report
+        .failures
+        .iter()
+        .filter(|f| matches!(f, Failure::Enclosed { .. }))
+        .collect();
+    assert_eq!(
+        shut,
+        [&Failure::Enclosed {
+            piece: asm.pieces.len() - 1,
+            step
+        }],
+        "{report}"
+    );
+}
+
+#[test]
+fn wall_needs_hollow_and_a_thickness_from_1_to_16() {
+    let tmp = tempfile::tempdir().unwrap();
+    for args in [
+        vec!["--wall", "2"],
+        vec!["--hollow", "--wall", "0"],
+        vec!["--hollow", "--wall", "17"],
+    ] {
+        let out = tmp.path().join("out");
+        let run = Command::new(env!("CARGO_BIN_EXE_brickwright"))
+            .args(["build", fixture("box.obj").to_str().unwrap(), "-o"])
+            .arg(&out)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        assert!(!out.exists(), "{args:?}");
+    }
+}
