@@ -9,7 +9,8 @@ use brickwright::assembly::{Assembly, Placed, Placement, Step, StepGrouping};
 use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
 use brickwright::physics::{
-    analyze, analyze_steps, analyze_steps_from, Ground, Params, CLUTCH_N, GRAVITY,
+    analyze, analyze_steps, analyze_steps_from, analyze_steps_told, Ground, Params, CLUTCH_N,
+    GRAVITY,
 };
 
 use Rot::{R0, R90};
@@ -418,4 +419,25 @@ fn every_step_of_a_real_build_agrees_with_a_full_solve() {
             assert!((a.usage - b.usage).abs() <= 0.02, "{name}");
         }
     }
+}
+
+/// The step check tells how far it is, a step at a time, as a progress
+/// display needs: counts that only go up, against the build's steps, and
+/// the same answer as without anyone told.
+#[test]
+fn the_step_check_tells_its_progress_in_steps() {
+    let asm = fixture_build("mug.obj", 16);
+    let params = Params::default();
+    let told = std::cell::RefCell::new(Vec::new());
+    let tell = |done, total| told.borrow_mut().push((done, total));
+    let checked = analyze_steps_told(&asm, &params, false, None, 1, Some(&tell)).unwrap();
+    let told = told.into_inner();
+    let steps = u64::from(asm.step_count());
+    assert_eq!(told.len() as u64, steps, "one report a step");
+    assert!(told.iter().all(|&(_, total)| total == steps));
+    assert!(told.windows(2).all(|w| w[0].0 < w[1].0));
+    assert_eq!(told[0].0, 0);
+    let quiet = analyze_steps(&asm, &params, false).unwrap();
+    assert_eq!(checked.first_failure, quiet.first_failure);
+    assert_eq!(checked.steps.len(), quiet.steps.len());
 }

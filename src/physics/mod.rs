@@ -133,7 +133,7 @@ use crate::catalog::PartSpec;
 
 use crate::assembly::Assembly;
 
-pub use steps::{analyze_steps, analyze_steps_from, analyze_steps_within};
+pub use steps::{analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_within};
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
 /// for where it comes from).

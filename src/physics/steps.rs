@@ -219,6 +219,26 @@ pub fn analyze_steps_from(
     deadline: Option<std::time::Instant>,
     from: u32,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    analyze_steps_told(
+        assembly,
+        params,
+        stop_at_first_failure,
+        deadline,
+        from,
+        None,
+    )
+}
+
+/// [`analyze_steps_from`], telling `tell` the steps checked so far and all
+/// there are as it goes, for a progress display.
+pub fn analyze_steps_told(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<std::time::Instant>,
+    from: u32,
+    tell: Option<&dyn Fn(u64, u64)>,
+) -> Result<StepsAnalysis, PhysicsError> {
     let start = std::time::Instant::now();
     params.check()?;
     let s = Structure::new(assembly, params);
@@ -273,7 +293,11 @@ pub fn analyze_steps_from(
         std::collections::HashMap::new();
     let mut begin = 0;
     let mut complete = true;
+    let total = bounds.len() as u64;
     for (k, jobs) in all_jobs.iter().enumerate() {
+        if let Some(tell) = tell {
+            tell(k as u64, total);
+        }
         if k < k0 {
             begin = bounds[k].1;
             continue;

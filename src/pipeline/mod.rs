@@ -105,7 +105,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     let settled = match opts.stability {
         Stability::Off => stability::Settled::unchecked(first),
         _ => stage(progress, "checking stability", &mut times.stability, || {
-            stability::stage(opts, first, &planner)
+            stability::stage(opts, first, &planner, progress)
         })?,
     };
 

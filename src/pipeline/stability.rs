@@ -29,8 +29,8 @@ use crate::catalog::Color;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
-    analyze, analyze_steps_from, analyze_steps_within, Analysis, Ground, Params, PhysicsError,
-    StepsAnalysis,
+    analyze, analyze_steps_from, analyze_steps_told, analyze_steps_within, Analysis, Ground,
+    Params, PhysicsError, StepsAnalysis,
 };
 use crate::search::SearchOutcome;
 
@@ -162,8 +162,11 @@ pub struct StabilityReport {
 pub type Plan = (SearchOutcome, Assembly, &'static str);
 
 /// Runs the stage on `plan`. `supports`: the repair may add support
-/// columns. `replan(seed)` searches again with another seed. Returns the
-/// plan to write, possibly repaired, and the report.
+/// columns. `replan(seed)` searches again with another seed. `tell` hears
+/// how many of the plan's steps the first check has covered, for a
+/// progress display. Returns the plan to write, possibly repaired, and the
+/// report.
+#[allow(clippy::too_many_arguments)]
 pub fn settle(
     mode: Stability,
     plan: Plan,
@@ -172,6 +175,7 @@ pub fn settle(
     budget: Duration,
     supports: bool,
     replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
+    tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
     // A budget too large for the clock is no budget (about 31 years).
     let deadline = Instant::now() + budget.min(Duration::from_secs(1_000_000_000));
@@ -182,6 +186,7 @@ pub fn settle(
         mode == Stability::Repair,
         deadline,
         &mut counts,
+        tell,
     )?;
     let before = Before {
         first_failure: first.check.first_failure,
@@ -213,7 +218,7 @@ pub fn settle(
             {
                 continue;
             }
-            let candidate = attempt(planned, params, true, deadline, &mut counts)?;
+            let candidate = attempt(planned, params, true, deadline, &mut counts, None)?;
             if candidate.better_than(&best) {
                 best = candidate;
                 reseeded = Some(other);
@@ -363,9 +368,10 @@ fn attempt(
     repair: bool,
     deadline: Instant,
     counts: &mut Counts,
+    tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
-    let mut check = analyze_steps_within(&plan.1, params, false, Some(deadline))?;
+    let mut check = analyze_steps_told(&plan.1, params, false, Some(deadline), 1, tell)?;
     counts.add(&check);
     let mut order_fix = None;
     let mut order_tried = None;
@@ -741,7 +747,9 @@ pub(super) fn stage(
     opts: &crate::pipeline::BuildOptions,
     first: Plan,
     planner: &super::plan::Planner<'_>,
+    progress: &dyn crate::pipeline::Progress,
 ) -> Result<Settled, crate::pipeline::BuildError> {
+    let tell = |done, total| progress.advance(done, total);
     let ((outcome, assembly, order), report, finished) = settle(
         opts.stability,
         first,
@@ -750,6 +758,7 @@ pub(super) fn stage(
         opts.stability_budget,
         opts.supports,
         &|seed| planner.plan(seed),
+        Some(&tell),
     )?;
     if opts.stability == Stability::Check && report.first_failure.is_some() {
         return Err(crate::pipeline::BuildError::Unstable {
