@@ -956,9 +956,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         unmapped_colors: parts.unmapped().iter().map(|c| c.0).collect(),
         components: crate::assembly::verify::components(&assembly),
         steps: assembly.step_count(),
-        booklet_pages: formats
-            .contains(Format::Pdf)
-            .then(|| crate::booklet::page_count(&assembly, &template)),
+        booklet_pages: rendered
+            .as_ref()
+            .and_then(|(_, b)| b.as_ref())
+            .map(|b| b.pages),
         stability: stability.as_ref().map(|(r, _)| r.clone()),
         order: order_name.into(),
         size_cm,
@@ -1032,7 +1033,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
                         files.add(&path, |w| w.write_all(&png))
                     }
                     _ => {
-                        let pdf = booklet.as_deref().unwrap_or_default();
+                        let pdf = booklet.as_ref().map_or(&[][..], |b| &b.pdf);
                         files.add(&path, |w| w.write_all(pdf))
                     }
                 }
