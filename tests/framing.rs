@@ -8,11 +8,18 @@
 //!   cut off); the scale changes rarely, by a quarter or more each time;
 //! - steps: 3 to 8 new pieces a step (mean at least 3 on models of 100
 //!   pieces or more), the steps numbered 1, 2, 3, ... in the order of the
-//!   pieces.
+//!   pieces;
+//! - the page: the booklet's step pictures, cut to the model, are mostly
+//!   model (little white around it), no model pixel runs under a step's
+//!   number or callout, nothing overlaps or leaves its cell or the page,
+//!   and a page holds more steps than the four of a fixed grid.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use brickwright::booklet::layout::{Ink, Rect, StepPlace};
+use brickwright::booklet::{plan_steps, BookletInput, Template};
+use brickwright::pipeline::pictures::{render_all, Pictures};
 use brickwright::pipeline::{self, BuildOptions, BuildOutput, Formats, Silent};
 use brickwright::render::{self, RenderOptions};
 use brickwright::voxel::Sizing;
@@ -151,6 +158,124 @@ fn check(fixture: &str, studs: u32) {
     );
 }
 
+/// Checks the booklet's step pages of a real build (see the module
+/// docs); returns the steps' count, the pages of steps, and each step's
+/// model share of its printed picture (the larger side of the model's box
+/// over the picture's).
+fn page_use(built: &BuildOutput) -> (usize, usize, Vec<f64>) {
+    let a = &built.assembly;
+    let notes: BTreeMap<u32, String> = built
+        .report
+        .stability
+        .iter()
+        .flat_map(|s| &s.supports)
+        .map(|c| (c.step, pipeline::SUPPORT_NOTE.to_string()))
+        .collect();
+    let pictures = Pictures {
+        assembly: a,
+        title: "model",
+        size_studs: [0.0; 3],
+        size_cm: [0.0; 3],
+        step_notes: notes.clone(),
+    };
+    let rendered = render_all(&pictures, true, &Silent).unwrap();
+    let template = Template::default();
+    let input = BookletInput {
+        title: "model",
+        assembly: a,
+        size_studs: [0.0; 3],
+        size_cm: [0.0; 3],
+        model: &rendered.model,
+        exploded: &rendered.exploded,
+        steps: &rendered.steps,
+        step_scales: &rendered.step_scales,
+        parts: &BTreeMap::new(),
+        step_notes: &notes,
+    };
+    let plan = plan_steps(&input, &template).unwrap();
+    let (pw, ph) = template.page.size.mm();
+    let m = template.page.margin;
+    let content = Rect {
+        x: m,
+        y: m,
+        w: pw - 2.0 * m,
+        h: ph - 2.0 * m,
+    };
+    let inside = |r: Rect, o: Rect| {
+        r.x >= o.x - 1e-3
+            && r.y >= o.y - 1e-3
+            && r.right() <= o.right() + 1e-3
+            && r.bottom() <= o.bottom() + 1e-3
+    };
+    let mut next = 1;
+    let mut shares = Vec::new();
+    for page in &plan {
+        let places: Vec<&StepPlace> = page.steps().collect();
+        assert!(!places.is_empty());
+        for (i, p) in places.iter().enumerate() {
+            // Every step once, in order: rows top to bottom, left to right.
+            assert_eq!(p.step, next);
+            next += 1;
+            let header = p.header();
+            assert!(inside(p.cell, content), "step {}: {p:?}", p.step);
+            assert!(inside(p.picture, p.cell), "step {}: {p:?}", p.step);
+            assert!(inside(header, p.cell), "step {}: {p:?}", p.step);
+            for q in &places[i + 1..] {
+                assert!(!p.cell.overlaps(&q.cell), "{p:?} {q:?}");
+            }
+            // Printed at the image's own aspect.
+            let s = p.picture.w / p.crop.width() as f32;
+            assert!((p.picture.h - p.crop.height() as f32 * s).abs() < 0.01);
+            // No model pixel under the header: each column's first ink.
+            let ink = Ink::of(&rendered.steps[p.step as usize - 1]);
+            for x in p.crop.x0..p.crop.x1 {
+                let top = ink.top[x as usize];
+                if top >= p.crop.y1 {
+                    continue;
+                }
+                let mx = p.picture.x + (x - p.crop.x0) as f32 * s;
+                let my = p.picture.y + (top - p.crop.y0) as f32 * s;
+                assert!(
+                    mx < header.x || mx > header.right() || my >= header.bottom(),
+                    "step {}: ink at ({mx:.1}, {my:.1}) mm under the header {header:?}",
+                    p.step
+                );
+            }
+            let b = ink.bbox.expect("a step shows something");
+            shares.push(f64::max(
+                f64::from(b.width()) / f64::from(p.crop.width()),
+                f64::from(b.height()) / f64::from(p.crop.height()),
+            ));
+        }
+    }
+    assert_eq!(next - 1, built.report.steps, "every step is on a page");
+    (built.report.steps as usize, plan.len(), shares)
+}
+
+/// The page checks and bounds: the printed pictures are at least 85% model
+/// across in the median step and 60% in the lowest tenth (the rest of the
+/// frame's white is cut away), and a page of steps holds at least five
+/// steps on average.
+fn check_pages(fixture: &str, built: &BuildOutput) {
+    let (steps, pages, shares) = page_use(built);
+    let (median, tenth) = (quantile(&shares, 0.5), quantile(&shares, 0.1));
+    eprintln!(
+        "{fixture}: {steps} steps on {pages} pages, printed share median {median:.2}, lowest tenth {tenth:.2}"
+    );
+    assert!(
+        median >= 0.85,
+        "{fixture}: printed share median {median:.2}"
+    );
+    assert!(
+        tenth >= 0.6,
+        "{fixture}: printed share lowest tenth {tenth:.2}"
+    );
+    assert!(
+        steps >= 5 * pages || pages == 1,
+        "{fixture}: {steps} steps on {pages} pages"
+    );
+}
+
 #[test]
 fn a_tall_model_is_framed_as_it_grows() {
     check("tower.glb", 20);
@@ -159,6 +284,14 @@ fn a_tall_model_is_framed_as_it_grows() {
 #[test]
 fn a_hollow_model_is_framed_and_stepped_for_people() {
     check("mug.obj", 20);
+}
+
+#[test]
+fn the_booklet_pages_are_filled_with_model_not_white() {
+    for (fixture, studs) in [("tower.glb", 20), ("house.obj", 16)] {
+        let tmp = tempfile::tempdir().unwrap();
+        check_pages(fixture, &build(fixture, studs, tmp.path()));
+    }
 }
 
 #[test]

@@ -6,20 +6,23 @@
 //!   in studs and centimetres;
 //! - the bill of materials: each part and colour with its picture, count,
 //!   name, colour name, and LDraw and BrickLink ids;
-//! - the step pages: a big step number, a parts-needed callout (pictures
-//!   with "2x" counts) and the step image. Several small steps share a
-//!   page; a step is never split;
+//! - the step pages: each step a big step number, a parts-needed callout
+//!   (a picture and "2x" count for each part and colour) and the step's
+//!   picture, cut to the model and printed at the size of what it shows;
+//!   steps sit in rows on a grid of thirds or halves of the page, a step
+//!   is never split (see [`layout`]);
 //! - a last page with the exploded view.
 //!
 //! Every page but the cover is numbered. Text is PDF text in a standard
 //! font (selectable, searchable, no font embedded), not pixels. The layout
-//! comes from a [`Template`]. Pages are planned first ([`plan_steps`], a
-//! pure function that tests check), then drawn with printpdf's operation
-//! lists.
+//! comes from a [`Template`]. Pages are planned first ([`plan_steps`], from
+//! what each picture shows; [`layout::plan`] is a pure function that tests
+//! check), then drawn with printpdf's operation lists.
 //!
 //! The images come from the caller (the pipeline renders them with
 //! brickwright's renderer); this module only lays them out.
 
+pub mod layout;
 pub mod template;
 
 use std::collections::BTreeMap;
@@ -37,6 +40,8 @@ use rayon::prelude::*;
 
 use crate::assembly::Assembly;
 use crate::catalog::{Color, PartKind};
+pub use layout::StepPage;
+use layout::{Ink, PixelBox, StepContent, CALLOUT_ITEM_W, CALLOUT_PAD, CALLOUT_PICTURE, MM_PER_PT};
 pub use template::Template;
 use template::{FontFamily, Rgb};
 
@@ -54,44 +59,16 @@ pub struct BookletInput<'a> {
     pub model: &'a RgbaImage,
     /// The exploded view.
     pub exploded: &'a RgbaImage,
-    /// One image per step, step 1 first.
+    /// One image per step, step 1 first, on white.
     pub steps: &'a [RgbaImage],
+    /// Pixels a stud's width measures in each step image: the steps of
+    /// one scale (one stage of the zoom) are cut to one crop.
+    pub step_scales: &'a [f32],
     /// A picture of each part in each colour the build uses.
     pub parts: &'a BTreeMap<(PartKind, Color), RgbaImage>,
     /// A short note under a step's parts, by step number (a support
     /// column's step says what it is for).
     pub step_notes: &'a BTreeMap<u32, String>,
-}
-
-/// How much of a page a step takes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Share {
-    /// A quarter page (four steps a page).
-    Quarter,
-    /// Half a page.
-    Half,
-    /// A whole page.
-    Full,
-}
-
-impl Share {
-    /// Steps a page of this share holds.
-    pub fn per_page(self) -> usize {
-        match self {
-            Share::Quarter => 4,
-            Share::Half => 2,
-            Share::Full => 1,
-        }
-    }
-}
-
-/// One step page: its share and the steps on it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct StepPage {
-    /// The share every step on the page takes.
-    pub share: Share,
-    /// Step numbers on the page, in order.
-    pub steps: Vec<u32>,
 }
 
 /// The new parts of each step, as callout lines: part, colour, count.
@@ -109,54 +86,36 @@ pub fn step_parts(assembly: &Assembly) -> Vec<Vec<(PartKind, Color, usize)>> {
         .collect()
 }
 
-/// Callout items a step's share holds (pictures in at most two rows).
-fn callout_capacity(share: Share, content_w: f32) -> usize {
-    let cell_w = match share {
-        Share::Quarter => content_w / 2.0,
-        Share::Half | Share::Full => content_w,
-    };
-    let per_row = ((cell_w - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W)
-        .floor()
-        .max(1.0) as usize;
-    per_row * if share == Share::Full { 3 } else { 2 }
-}
-
-/// Plans the step pages: each step takes the smallest share its callout
-/// fits (never more steps a page than the template allows), and a page
-/// holds consecutive steps of one share. A step is never split.
-pub fn plan_steps(callout_lines: &[usize], template: &Template) -> Vec<StepPage> {
-    let content_w = template.page.size.mm().0 - 2.0 * template.page.margin;
-    let max_per_page = template.steps.per_page as usize;
-    let need = |lines: usize| {
-        [Share::Quarter, Share::Half, Share::Full]
-            .into_iter()
-            .filter(|s| s.per_page() <= max_per_page)
-            .find(|&s| lines <= callout_capacity(s, content_w))
-            .unwrap_or(Share::Full)
-    };
-    let mut pages: Vec<StepPage> = Vec::new();
-    for (i, &lines) in callout_lines.iter().enumerate() {
-        let share = need(lines);
-        let step = i as u32 + 1;
-        match pages.last_mut() {
-            Some(page) if page.share == share && page.steps.len() < share.per_page() => {
-                page.steps.push(step);
-            }
-            _ => pages.push(StepPage {
-                share,
-                steps: vec![step],
-            }),
-        }
+/// Lays out the step pages of `input` (see [`layout`]): what each step's
+/// picture shows is measured here, in parallel.
+pub fn plan_steps(input: &BookletInput<'_>, template: &Template) -> io::Result<Vec<StepPage>> {
+    let parts = step_parts(input.assembly);
+    let n = parts.len();
+    if input.steps.len() != n || input.step_scales.len() != n {
+        return Err(io::Error::other(format!(
+            "the booklet has {} step images and {} step scales for {n} steps",
+            input.steps.len(),
+            input.step_scales.len(),
+        )));
     }
-    pages
+    let inks: Vec<Ink> = input.steps.par_iter().map(Ink::of).collect();
+    let content: Vec<StepContent<'_>> = inks
+        .iter()
+        .zip(input.step_scales)
+        .zip(&parts)
+        .enumerate()
+        .map(|(i, ((ink, &stud_px), items))| StepContent {
+            ink,
+            stud_px,
+            items: items.len(),
+            note: input.step_notes.get(&(i as u32 + 1)).map(String::as_str),
+        })
+        .collect();
+    let fonts = Fonts::new(template.fonts.family);
+    Ok(layout::plan(&content, template, &|s, size, bold| {
+        fonts.width(s, size, bold)
+    }))
 }
-
-/// Width of a callout item (picture and count), millimetres.
-const CALLOUT_ITEM_W: f32 = 20.0;
-/// Padding inside the callout box, millimetres.
-const CALLOUT_PAD: f32 = 2.5;
-/// Side of a callout picture, millimetres.
-const CALLOUT_PICTURE: f32 = 15.0;
 
 /// Page furniture: fonts and their metrics.
 struct Fonts {
@@ -278,7 +237,17 @@ impl PageOps {
 
     /// A thin horizontal line.
     fn rule(&mut self, x0: f32, x1: f32, y: f32, color: Rgb) {
-        let (a, b) = (self.point(x0, y), self.point(x1, y));
+        self.line((x0, y), (x1, y), color);
+    }
+
+    /// A thin vertical line.
+    fn vrule(&mut self, x: f32, y0: f32, y1: f32, color: Rgb) {
+        self.line((x, y0), (x, y1), color);
+    }
+
+    /// A thin line from `a` to `b`.
+    fn line(&mut self, a: (f32, f32), b: (f32, f32), color: Rgb) {
+        let (a, b) = (self.point(a.0, a.1), self.point(b.0, b.1));
         self.ops.extend([
             Op::SetOutlineColor {
                 col: pdf_rgb(color),
@@ -304,19 +273,19 @@ impl PageOps {
 
     /// An image fitted into the box (x, y, w, h), centred, aspect kept.
     fn image(&mut self, img: &Placed, x: f32, y: f32, w: f32, h: f32) {
-        self.image_at(img, x, y, w, h, false);
-    }
-
-    /// An image fitted into the box, centred across, at the top of the box
-    /// when `top` (else centred down too).
-    fn image_at(&mut self, img: &Placed, x: f32, y: f32, w: f32, h: f32, top: bool) {
         if img.width == 0 || img.height == 0 || w <= 0.0 || h <= 0.0 {
             return;
         }
         let scale = (w / img.width as f32).min(h / img.height as f32);
         let (iw, ih) = (img.width as f32 * scale, img.height as f32 * scale);
-        let ix = x + (w - iw) / 2.0;
-        let iy = if top { y } else { y + (h - ih) / 2.0 };
+        self.image_in(img, (x + (w - iw) / 2.0, y + (h - ih) / 2.0, iw, ih));
+    }
+
+    /// An image printed exactly over the box (x, y, w, h).
+    fn image_in(&mut self, img: &Placed, (ix, iy, iw, ih): (f32, f32, f32, f32)) {
+        if img.width == 0 || img.height == 0 || iw <= 0.0 || ih <= 0.0 {
+            return;
+        }
         let ll = self.point(ix, iy + ih);
         // At 72 dpi one pixel is one point; scale from there.
         let pt_per_mm = 72.0 / 25.4;
@@ -342,10 +311,18 @@ struct Placed {
     height: usize,
 }
 
+/// An image to add: a part of a picture, and the colour it is flattened
+/// onto.
+struct ImageJob<'a> {
+    img: &'a RgbaImage,
+    crop: PixelBox,
+    bg: Rgb,
+}
+
 /// The images of a booklet, named as they are added and compressed all
 /// at once, in parallel, when the layout is done.
 struct Images<'a> {
-    jobs: Vec<(&'a RgbaImage, Rgb)>,
+    jobs: Vec<ImageJob<'a>>,
 }
 
 impl<'a> Images<'a> {
@@ -357,12 +334,23 @@ impl<'a> Images<'a> {
 
     /// Adds `img` flattened onto `bg`: printed pages have no alpha.
     fn add_on(&mut self, img: &'a RgbaImage, bg: Rgb) -> Placed {
+        let whole = PixelBox {
+            x0: 0,
+            y0: 0,
+            x1: img.width(),
+            y1: img.height(),
+        };
+        self.add_crop(img, whole, bg)
+    }
+
+    /// Adds the part `crop` of `img` flattened onto `bg`.
+    fn add_crop(&mut self, img: &'a RgbaImage, crop: PixelBox, bg: Rgb) -> Placed {
         let id = XObjectId(format!("Im{}", self.jobs.len()));
-        self.jobs.push((img, bg));
+        self.jobs.push(ImageJob { img, crop, bg });
         Placed {
             id,
-            width: img.width() as usize,
-            height: img.height() as usize,
+            width: crop.width() as usize,
+            height: crop.height() as usize,
         }
     }
 
@@ -372,14 +360,23 @@ impl<'a> Images<'a> {
         let streams: Vec<Vec<u8>> = self
             .jobs
             .par_iter()
-            .map(|&(img, bg)| {
-                // Flattened onto the background, RGB rows.
-                let mut data = Vec::with_capacity(img.width() as usize * img.height() as usize * 3);
-                for p in img.pixels() {
-                    let a = u32::from(p.0[3]);
-                    for (c, b) in p.0[..3].iter().zip(bg.0) {
-                        let (c, b) = (u32::from(*c), u32::from(b));
-                        data.push(((c * a + b * (255 - a) + 127) / 255) as u8);
+            .map(|job| {
+                // The crop flattened onto the background, RGB rows.
+                let (c, w) = (job.crop, job.img.width() as usize);
+                let mut data = Vec::with_capacity(c.width() as usize * c.height() as usize * 3);
+                for row in job
+                    .img
+                    .as_raw()
+                    .chunks_exact(w * 4)
+                    .take(c.y1 as usize)
+                    .skip(c.y0 as usize)
+                {
+                    for p in row[c.x0 as usize * 4..c.x1 as usize * 4].chunks_exact(4) {
+                        let a = u32::from(p[3]);
+                        for (c, b) in p[..3].iter().zip(job.bg.0) {
+                            let (c, b) = (u32::from(*c), u32::from(b));
+                            data.push(((c * a + b * (255 - a) + 127) / 255) as u8);
+                        }
                     }
                 }
                 let mut z = ZlibEncoder::new(Vec::new(), Compression::new(3));
@@ -388,8 +385,8 @@ impl<'a> Images<'a> {
                 z.finish().expect("deflating into memory does not fail")
             })
             .collect();
-        for (i, ((img, _), content)) in self.jobs.iter().zip(streams).enumerate() {
-            let (w, h) = (img.width() as usize, img.height() as usize);
+        for (i, (job, content)) in self.jobs.iter().zip(streams).enumerate() {
+            let (w, h) = (job.crop.width() as usize, job.crop.height() as usize);
             let dict = BTreeMap::from([
                 ("Type".to_string(), DictItem::Name(b"XObject".to_vec())),
                 ("Subtype".to_string(), DictItem::Name(b"Image".to_vec())),
@@ -423,21 +420,15 @@ impl<'a> Images<'a> {
     }
 }
 
-/// Writes the booklet as PDF.
+/// Writes the booklet as PDF; returns its number of pages.
 pub fn write_booklet<W: Write + ?Sized>(
     w: &mut W,
     input: &BookletInput<'_>,
     template: &Template,
-) -> io::Result<()> {
-    let pdf = booklet_bytes(input, template)?;
-    w.write_all(&pdf)
-}
-
-/// The pages the booklet will have: cover, parts list pages, step pages,
-/// exploded view.
-pub fn page_count(assembly: &Assembly, template: &Template) -> usize {
-    let lines: Vec<usize> = step_parts(assembly).iter().map(Vec::len).collect();
-    1 + bom_pages(bom_lines(assembly).len(), template) + plan_steps(&lines, template).len() + 1
+) -> io::Result<usize> {
+    let (pdf, pages) = booklet_bytes(input, template)?;
+    w.write_all(&pdf)?;
+    Ok(pages)
 }
 
 fn bom_lines(assembly: &Assembly) -> Vec<(PartKind, Color, usize)> {
@@ -458,21 +449,9 @@ fn bom_rows_per_page(template: &Template) -> usize {
     ((usable / BOM_CELL_H).floor() as usize).max(1)
 }
 
-fn bom_pages(lines: usize, template: &Template) -> usize {
-    lines
-        .div_ceil(BOM_COLUMNS * bom_rows_per_page(template))
-        .max(1)
-}
-
-fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> {
+fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<(Vec<u8>, usize)> {
     let steps = step_parts(input.assembly);
-    if input.steps.len() != steps.len() {
-        return Err(io::Error::other(format!(
-            "the booklet has {} step images for {} steps",
-            input.steps.len(),
-            steps.len()
-        )));
-    }
+    let plan = plan_steps(input, t)?;
     let fonts = Fonts::new(t.fonts.family);
     let (pw, ph) = t.page.size.mm();
     let m = t.page.margin;
@@ -590,65 +569,27 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     }
 
     // Steps.
-    let lines: Vec<usize> = steps.iter().map(Vec::len).collect();
-    for plan in plan_steps(&lines, t) {
+    for plan in &plan {
         let mut page = PageOps::new(ph);
-        let (cols, rows) = match plan.share {
-            Share::Quarter => (2, 2),
-            Share::Half => (1, 2),
-            Share::Full => (1, 1),
-        };
-        let (sw, sh) = (cw / cols as f32, (ch - 4.0) / rows as f32);
-        for (i, &step) in plan.steps.iter().enumerate() {
-            let (x, y) = (m + (i % cols) as f32 * sw, m + (i / cols) as f32 * sh);
-            if i > 0 && i % cols == 0 {
-                page.rule(m, pw - m, y - 1.0, t.colors.rule);
+        for (r, row) in plan.rows.iter().enumerate() {
+            if r > 0 {
+                let y = row.area.y - layout::ROW_GAP / 2.0;
+                page.rule(m, pw - m, y, t.colors.rule);
             }
-            let ns = t.fonts.step_number_size;
-            let label = step.to_string();
-            page.text(
-                &fonts,
-                x + 1.0,
-                y + ns * 0.3528,
-                (ns, true, t.colors.accent),
-                &label,
-            );
-            // Parts-needed callout to the right of the number.
-            let items = &steps[step as usize - 1];
-            let cx = x + fonts.width(&label, ns, true) + 5.0;
-            let avail = (x + sw - 2.0 - cx).max(CALLOUT_ITEM_W + 2.0 * CALLOUT_PAD);
-            let per_row = ((avail - 2.0 * CALLOUT_PAD) / CALLOUT_ITEM_W)
-                .floor()
-                .max(1.0) as usize;
-            let used_cols = per_row.min(items.len()).max(1);
-            let item_rows = items.len().div_ceil(per_row).max(1);
-            let item_h = CALLOUT_PICTURE + ts * 0.3528 + 3.0;
-            let box_w = used_cols as f32 * CALLOUT_ITEM_W + 2.0 * CALLOUT_PAD;
-            let box_h = item_rows as f32 * item_h + 2.0 * CALLOUT_PAD;
-            page.fill(cx, y, box_w, box_h, t.colors.callout);
-            for (j, &(part, color, count)) in items.iter().enumerate() {
-                let ix = cx + CALLOUT_PAD + (j % per_row) as f32 * CALLOUT_ITEM_W;
-                let iy = y + CALLOUT_PAD + (j / per_row) as f32 * item_h;
-                if let Some(pic) = callout_pictures.get(&(part, color)) {
-                    page.image(pic, ix, iy, CALLOUT_ITEM_W - 2.0, CALLOUT_PICTURE);
-                }
-                let label = format!("{count}x");
-                page.text(
-                    &fonts,
-                    ix + 1.0,
-                    iy + CALLOUT_PICTURE + ts * 0.3528 + 1.0,
-                    (ts, true, text),
-                    &label,
-                );
+            for place in row.steps.iter().skip(1) {
+                let x = place.cell.x - layout::COLUMN_GAP / 2.0;
+                page.vrule(x, row.area.y, row.area.bottom(), t.colors.rule);
             }
-            let mut top = y + box_h.max(ns * 0.3528) + 3.0;
-            if let Some(note) = input.step_notes.get(&step) {
-                top += ts * 0.3528;
-                page.text(&fonts, x + 1.0, top, (ts, false, text), note);
-                top += 2.0;
+            for place in &row.steps {
+                // The picture first: the header is drawn over its white
+                // (the layout keeps the model's pixels out from under it).
+                let img = &input.steps[place.step as usize - 1];
+                let pic = images.add_crop(img, place.crop, Rgb([255, 255, 255]));
+                let r = place.picture;
+                page.image_in(&pic, (r.x, r.y, r.w, r.h));
+                let items = &steps[place.step as usize - 1];
+                draw_step(&mut page, &fonts, t, place, items, &callout_pictures);
             }
-            let img = images.add(&input.steps[step as usize - 1]);
-            page.image_at(&img, x + 1.0, top, sw - 2.0, y + sh - top - 2.0, true);
         }
         finish(page, &mut pages, true);
     }
@@ -669,12 +610,55 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<Vec<u8>> 
     finish(page, &mut pages, true);
 
     images.finish(&mut doc);
+    let pages_made = pages.len();
     let mut warnings = Vec::new();
     let mut pdf = doc
         .with_pages(pages)
         .save(&PdfSaveOptions::default(), &mut warnings);
     stable_ids(&mut pdf);
-    Ok(pdf)
+    Ok((pdf, pages_made))
+}
+
+/// A step's number, callout and note.
+fn draw_step(
+    page: &mut PageOps,
+    fonts: &Fonts,
+    t: &Template,
+    place: &layout::StepPlace,
+    items: &[(PartKind, Color, usize)],
+    pictures: &BTreeMap<(PartKind, Color), Placed>,
+) {
+    let (ts, text) = (t.fonts.text_size, t.colors.text);
+    let ns = t.fonts.step_number_size;
+    let n = place.number;
+    page.text(
+        fonts,
+        n.x,
+        n.bottom(),
+        (ns, true, t.colors.accent),
+        &place.step.to_string(),
+    );
+    let c = place.callout;
+    page.fill(c.x, c.y, c.w, c.h, t.colors.callout);
+    let item_h = CALLOUT_PICTURE + ts * MM_PER_PT + 2.5;
+    let per_row = place.per_row.max(1);
+    for (j, &(part, color, count)) in items.iter().enumerate() {
+        let ix = c.x + CALLOUT_PAD + (j % per_row) as f32 * CALLOUT_ITEM_W;
+        let iy = c.y + CALLOUT_PAD + (j / per_row) as f32 * item_h;
+        if let Some(pic) = pictures.get(&(part, color)) {
+            page.image(pic, ix, iy, CALLOUT_ITEM_W - 2.0, CALLOUT_PICTURE);
+        }
+        page.text(
+            fonts,
+            ix + 1.0,
+            iy + CALLOUT_PICTURE + ts * MM_PER_PT + 0.5,
+            (ts, true, text),
+            &format!("{count}x"),
+        );
+    }
+    for (x, y, line) in &place.note {
+        page.text(fonts, *x, *y, (ts, false, text), line);
+    }
 }
 
 /// Replaces the file identifiers printpdf draws from a process-wide
@@ -763,20 +747,26 @@ mod tests {
             model: &model,
             exploded: &exploded,
             steps: &steps,
+            step_scales: &vec![12.0; steps.len()],
             parts: &parts,
             step_notes: &BTreeMap::from([(2, "Support column".to_string())]),
         };
         let mut pdf = Vec::new();
-        write_booklet(&mut pdf, &input, template).unwrap();
-        (pdf, page_count(&a, template))
+        let pages = write_booklet(&mut pdf, &input, template).unwrap();
+        // Step 2's note is wrapped in its cell.
+        let plan = plan_steps(&input, template).unwrap();
+        let two = plan.iter().flat_map(StepPage::steps).find(|p| p.step == 2);
+        assert!(two.is_some_and(|p| !p.note.is_empty()));
+        assert_eq!(pages, 1 + 1 + plan.len() + 1);
+        (pdf, pages)
     }
 
     #[test]
     fn the_booklet_is_a_pdf_with_the_planned_pages() {
         let (pdf, pages) = sample_pdf(&Template::default());
         assert!(pdf.starts_with(b"%PDF-"));
-        // Cover, one parts-list page, 6 steps on two quarter pages, exploded view.
-        assert_eq!(pages, 1 + 1 + 2 + 1);
+        // Cover, one parts-list page, 6 small steps on one page, exploded view.
+        assert_eq!(pages, 1 + 1 + 1 + 1);
         // The same booklet twice in one process: the same bytes.
         let again = sample_pdf(&Template::default()).0;
         assert!(pdf == again, "booklets differ");
@@ -784,28 +774,5 @@ mod tests {
         letter.page.size = template::PageSize::Letter;
         letter.steps.per_page = 1;
         assert_eq!(sample_pdf(&letter).1, 1 + 1 + 6 + 1);
-    }
-
-    #[test]
-    fn small_steps_share_pages_and_big_ones_get_room() {
-        let t = Template::default();
-        // Quarter cells hold 2 rows of 4 items on A4 with 12 mm margins.
-        let plan = plan_steps(&[1, 2, 1, 3, 1, 12, 1, 1, 30], &t);
-        let shares: Vec<(Share, Vec<u32>)> = plan.into_iter().map(|p| (p.share, p.steps)).collect();
-        assert_eq!(
-            shares,
-            [
-                (Share::Quarter, vec![1, 2, 3, 4]),
-                (Share::Quarter, vec![5]),
-                (Share::Half, vec![6]),
-                (Share::Quarter, vec![7, 8]),
-                (Share::Full, vec![9]),
-            ]
-        );
-        let mut one = t.clone();
-        one.steps.per_page = 1;
-        assert!(plan_steps(&[1, 1, 1], &one)
-            .iter()
-            .all(|p| p.share == Share::Full && p.steps.len() == 1));
     }
 }

@@ -11,7 +11,7 @@
 //!
 //! let t = Template::parse("[page]\nsize = \"Letter\"\n", "mine.toml").unwrap();
 //! assert_eq!(t.page.size, PageSize::Letter);
-//! assert_eq!(t.steps.per_page, 4); // the default
+//! assert_eq!(t.steps.columns, 3); // the default
 //! let err = Template::parse("[page]\nsize = \"A5\"\n", "mine.toml").unwrap_err();
 //! assert!(err.to_string().starts_with("mine.toml:2: "), "{err}");
 //! ```
@@ -110,8 +110,10 @@ pub struct PageSection {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StepsSection {
-    /// At most this many steps on a page: 1, 2 or 4.
+    /// At most this many steps on a page: 1 to 12.
     pub per_page: u32,
+    /// At most this many steps side by side: 1, 2 or 3.
+    pub columns: u32,
 }
 
 /// `[fonts]`.
@@ -259,10 +261,16 @@ impl Template {
                 ),
             ));
         }
-        if ![1, 2, 4].contains(&self.steps.per_page) {
+        if !(1..=12).contains(&self.steps.per_page) {
             return Err((
                 "per_page",
-                format!("per_page must be 1, 2 or 4, not {}", self.steps.per_page),
+                format!("per_page must be 1 to 12, not {}", self.steps.per_page),
+            ));
+        }
+        if !(1..=3).contains(&self.steps.columns) {
+            return Err((
+                "columns",
+                format!("columns must be 1, 2 or 3, not {}", self.steps.columns),
             ));
         }
         let f = &self.fonts;
@@ -314,7 +322,8 @@ mod tests {
         let cases = [
             ("[page]\nsize = \"A5\"\n", 2, "A5"),
             ("[page]\nmargin = 200.0\n", 2, "margin"),
-            ("[steps]\nper_page = 3\n", 2, "per_page"),
+            ("[steps]\nper_page = 13\n", 2, "per_page"),
+            ("[steps]\n\ncolumns = 4\n", 3, "columns"),
             ("[fonts]\n\ntext_size = 1.0\n", 3, "text_size"),
             ("[colors]\naccent = \"red\"\n", 2, "#B40000"),
             (

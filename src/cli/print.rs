@@ -47,7 +47,10 @@ pub fn build_summary(r: &BuildReport, out_dir: &Path) {
     };
     let steps: Vec<&String> = r.outputs.iter().filter(|f| is_step(f)).collect();
     for f in r.outputs.iter().filter(|f| !is_step(f)) {
-        outln!("  wrote {f}");
+        match r.booklet_pages.filter(|_| f.ends_with(".pdf")) {
+            Some(n) => outln!("  wrote {f} ({n} pages)"),
+            None => outln!("  wrote {f}"),
+        }
     }
     if let Some(first) = steps.first() {
         let dir = std::path::Path::new(first.as_str())

@@ -138,14 +138,15 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         _ => None,
     };
 
-    let report = report::compose(opts, &mesh, &model, &setup, &settled, hollow, times);
+    let pages = booklet.as_ref().map(|b| b.pages);
+    let report = report::compose(opts, &mesh, &model, &settled, hollow, pages, times);
     progress.stage("writing");
     let report = write::write(
         opts,
         &settled,
         &pictures,
         rendered.as_ref(),
-        booklet.as_deref(),
+        booklet.as_ref().map(|b| b.pdf.as_slice()),
         report,
     )?;
     progress.done();

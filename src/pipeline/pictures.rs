@@ -37,6 +37,8 @@ pub struct Pictures<'a> {
 pub struct Rendered {
     /// One image a step, step 1 first (empty unless asked for).
     pub steps: Vec<RgbaImage>,
+    /// Pixels a stud's width measures in each step image.
+    pub step_scales: Vec<f32>,
     /// The finished model.
     pub model: RgbaImage,
     /// The exploded view with the finished model beside it.
@@ -76,10 +78,15 @@ pub fn render_all(
     } else {
         Vec::new()
     };
+    // A camera's scale is pixels an LDU; a stud is 20 LDU across.
+    let step_scales = (0..step_images.len())
+        .map(|n| renderer.step_camera(n).scale() * 20.0)
+        .collect();
     let model = renderer.model_image();
     let exploded = exploded_view(p.assembly, &model)?;
     Ok(Rendered {
         steps: step_images,
+        step_scales,
         model,
         exploded,
     })
@@ -196,8 +203,16 @@ fn part_images(assembly: &Assembly) -> Result<BTreeMap<(PartKind, Color), RgbaIm
         .collect()
 }
 
-/// The booklet PDF's bytes.
-pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::Result<Vec<u8>> {
+/// A laid-out booklet.
+pub struct Booklet {
+    /// The PDF's bytes.
+    pub pdf: Vec<u8>,
+    /// Its number of pages.
+    pub pages: usize,
+}
+
+/// The booklet PDF.
+pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::Result<Booklet> {
     let parts = part_images(p.assembly).map_err(std::io::Error::other)?;
     let input = BookletInput {
         title: p.title,
@@ -207,12 +222,13 @@ pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::
         model: &r.model,
         exploded: &r.exploded,
         steps: &r.steps,
+        step_scales: &r.step_scales,
         parts: &parts,
         step_notes: &p.step_notes,
     };
     let mut pdf = Vec::new();
-    write_booklet(&mut pdf, &input, template)?;
-    Ok(pdf)
+    let pages = write_booklet(&mut pdf, &input, template)?;
+    Ok(Booklet { pdf, pages })
 }
 
 /// The finished model with each piece coloured by the share of its clutch

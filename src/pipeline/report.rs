@@ -2,11 +2,11 @@
 
 use serde::Serialize;
 
-use super::input::{Setup, Voxels};
+use super::input::Voxels;
 use super::options::step_name;
 use super::pictures::size_cm;
 use super::stability::Settled;
-use super::{BuildOptions, Format, Formats, Stability, StabilityReport};
+use super::{BuildOptions, Formats, Stability, StabilityReport};
 use crate::assembly::Assembly;
 use crate::catalog::{Color, Palette};
 use crate::export::partslist::{Condition, PartsList, PartsRow};
@@ -253,22 +253,22 @@ pub(super) fn mesh_color_report(
     }
 }
 
-/// The report of a settled build of `mesh`, its voxels `voxels`, made
-/// with `setup`'s rules (`hollow`: beside the solid build), the stages
-/// having taken `times` (the outputs and
+/// The report of a settled build of `mesh`, its voxels `voxels`
+/// (`hollow`: beside the solid build), its booklet `booklet_pages` long,
+/// the stages having taken `times` (the outputs and
 /// the write time are filled in when they are written).
 pub(super) fn compose(
     opts: &BuildOptions,
     mesh: &Mesh,
     voxels: &Voxels,
-    setup: &Setup,
     settled: &Settled,
     hollow: Option<super::hollow::HollowReport>,
+    booklet_pages: Option<usize>,
     times: StageTimes,
 ) -> BuildReport {
     let assembly = &settled.assembly;
     let outcome = &settled.outcome;
-    let layer_ldu = setup.rules.layer_ldu();
+    let layer_ldu = assembly.layer_ldu;
     let (nx, ny, nz) = outcome.voxels.dims();
     let parts = PartsList::of(assembly);
     let pieces = assembly.pieces.len();
@@ -299,10 +299,7 @@ pub(super) fn compose(
         hollow,
         components: crate::assembly::verify::components(assembly),
         steps: assembly.step_count(),
-        booklet_pages: opts
-            .formats
-            .contains(Format::Pdf)
-            .then(|| crate::booklet::page_count(assembly, &setup.template)),
+        booklet_pages,
         stability: settled.stability.as_ref().map(|(r, _)| r.clone()),
         order: settled.order.into(),
         size_cm: size_cm(outcome.voxels.dims(), layer_ldu),

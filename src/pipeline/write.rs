@@ -10,13 +10,13 @@ use crate::export::partslist::{write_bricklink, write_rebrickable_csv, PartsList
 use crate::fsutil::{refuse_link, CreatedDirs, Outputs};
 use crate::ldraw::{write_ldr, LdrMeta};
 
-/// The booklet PDF's bytes.
+/// The booklet: its PDF and page count.
 pub(super) fn booklet(
     opts: &BuildOptions,
     pictures: &Pictures<'_>,
     rendered: &Rendered,
     template: &Template,
-) -> Result<Vec<u8>, BuildError> {
+) -> Result<pictures::Booklet, BuildError> {
     pictures::booklet(pictures, rendered, template).map_err(|reason| BuildError::Write {
         path: opts
             .out_dir
