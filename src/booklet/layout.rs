@@ -10,7 +10,7 @@
 //!   white its frame had around the model;
 //! - it is printed at [`STUD_MM`] a stud, at least [`MIN_PICTURE_W`] wide
 //!   and at most half the page's width (the whole width when the template
-//!   puts one step a row) and [`MAX_PICTURE_H`] of the page's height: a
+//!   puts one step a row) and a step at most [`MAX_STEP_H`] of the page's height: a
 //!   stage that shows the first few bricks gets a small picture, the
 //!   finished model a big one;
 //! - the step number and the parts callout (one picture and count for each

@@ -1,14 +1,14 @@
 //! The whole job: mesh file in, verified LDraw build and report out.
 //!
 //! [`build`] runs the stages in order, each a function with its own input
-//! and output: [`load`](input::load) the mesh,
-//! [`voxelize`](input::voxelize) it, [`layout`](plan::Planner::layout)
-//! the pieces, [`order`](plan::Planner::order) them into verified steps,
-//! check and repair their [`stability`], draw the [`pictures`] and the
-//! booklet, and [`write`](write::write) every output. The assembly is
-//! verified with the independent [`verify`](crate::assembly::verify)
-//! before anything is written, and every output is written atomically: a
-//! failed run leaves no file behind.
+//! and output, in a module named for it: `input` loads the rules, the mesh
+//! and voxelizes it; `plan` lays the pieces out and orders them in
+//! verified steps; [`stability`] checks and repairs every step;
+//! [`pictures`] draws the step images and the booklet; `write` writes every
+//! output; `report` is what `report.json` says. The assembly is verified
+//! with the independent [`verify`](crate::assembly::verify) before
+//! anything is written, and every output is written atomically: a failed
+//! run leaves no file behind.
 
 use std::time::Instant;
 

@@ -63,7 +63,7 @@ pub struct SearchOptions {
     /// once every node", so 5 to 1). 0, the default, never tries them.
     pub complex_every: u32,
     /// Build a shell with walls this thick and the inside empty (see
-    /// [`crate::voxel::hollow`]); `None`, the default, builds solid.
+    /// [`crate::voxel::hollow()`]); `None`, the default, builds solid.
     pub hollow: Option<Wall>,
 }
 
