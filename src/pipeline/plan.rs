@@ -87,18 +87,11 @@ impl<'a> Planner<'a> {
         &self,
         settled: &super::stability::Settled,
     ) -> Result<Option<super::hollow::HollowReport>, BuildError> {
-        let model = &self.voxels.model;
-        let guide = search::Guide {
-            slant: Some(&model.slant),
-            surface: Some(&model.surface),
-            colors: self.voxels.labels.as_deref(),
-            progress: None,
-        };
         super::hollow::report(
             &settled.assembly,
             &settled.outcome,
-            &model.grid,
-            guide,
+            &self.voxels.model.grid,
+            self.guide(None),
             self.rules,
             &self.opts.search,
         )
@@ -106,6 +99,18 @@ impl<'a> Planner<'a> {
             file: self.file.clone(),
             reason,
         })
+    }
+
+    /// What the voxelizer knows of the model, for the search; `progress`
+    /// hears how far it is.
+    fn guide<'g>(&'g self, progress: Option<&'g dyn Fn(u64, u64)>) -> search::Guide<'g> {
+        let model = &self.voxels.model;
+        search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+            colors: self.voxels.labels.as_deref(),
+            progress,
+        }
     }
 
     /// A verified, grouped build from the layout with `seed`.
@@ -132,12 +137,7 @@ impl<'a> Planner<'a> {
         let opts = self.opts;
         let model = &self.voxels.model;
         let tell = |done, total| self.progress.advance(done, total);
-        let guide = search::Guide {
-            slant: Some(&model.slant),
-            surface: Some(&model.surface),
-            colors: self.voxels.labels.as_deref(),
-            progress: told.then_some(&tell as &dyn Fn(u64, u64)),
-        };
+        let guide = self.guide(told.then_some(&tell as &dyn Fn(u64, u64)));
         let search_opts = opts.search.clone().with_seed(seed);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
