@@ -301,6 +301,48 @@ fn the_check_stops_at_its_time_budget_and_says_so() {
     assert!(st["mean_score"].as_f64().unwrap() > 0.0, "{st}");
 }
 
+#[test]
+fn past_its_budget_the_stage_analyses_the_finished_model_once_and_names_what_fails() {
+    // The gallows tips over: with the budget spent at once, no step is
+    // checked, and neither the order repair, the support columns, other
+    // layouts nor the baseplate's check may run past it; the one analysis
+    // is the finished model's, and the failure names its pieces.
+    let tmp = tempfile::tempdir().unwrap();
+    let (run, out) = build_gallows(
+        tmp.path(),
+        &["--formats", "ldr", "--stability-budget", "0.000001"],
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("(score = 1 - share of stud clutch used; 1 analysis)"),
+        "{stdout}"
+    );
+    let r = report(&out);
+    let st = &r["stability"];
+    assert_eq!(st["complete"], false, "{st}");
+    assert_eq!(st["steps_checked"], 0, "{st}");
+    assert_eq!(st["solves"], 1, "{st}");
+    assert_eq!(st["stands_on_baseplate"], Value::Null, "{st}");
+    assert_eq!(st["support_pieces"], 0, "{st}");
+    let failure = st["failure"].as_str().unwrap();
+    assert!(
+        failure.contains("piece ") && failure.contains("Brick 1 x 6"),
+        "{failure}"
+    );
+    let repairs: Vec<&str> = st["repairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        repairs,
+        ["layout: the stability budget ran out before other layouts of the same voxels could be tried"],
+        "{st}"
+    );
+}
+
 /// A 1x4 base on the table, a 1x6 overhang clutched to its last stud, and
 /// a 1x2 counterweight on its other end: built overhang first, the base
 /// tips at step 2 (the known answer of tests/physics.rs).

@@ -109,8 +109,11 @@ fn print_build_stability(st: &StabilityReport) {
         (Some(step), _) => format!("does not stand from step {step} on"),
     };
     outln!(
-        "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} analyses)",
-        st.min_score, st.mean_score, st.solves
+        "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} {})",
+        st.min_score,
+        st.mean_score,
+        st.solves,
+        if st.solves == 1 { "analysis" } else { "analyses" }
     );
     for line in &st.repairs {
         outln!("  repaired {line}");

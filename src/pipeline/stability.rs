@@ -204,10 +204,12 @@ pub fn settle(
     if mode == Stability::Repair && best.check.first_failure.is_some() {
         // Other layouts of the same voxels; the first that stands at every
         // step (after its own order repair) is kept, else the best tried.
+        let mut tried = 0;
         for k in 1..=RESEEDS {
             if Instant::now() >= deadline {
                 break;
             }
+            tried += 1;
             let other = seed.wrapping_add(k);
             let planned = replan(other)?;
             // The finished model first: one analysis rules most layouts out.
@@ -237,9 +239,15 @@ pub fn settle(
                     "it fails later or less"
                 }
             ));
+        } else if tried == 0 {
+            repairs.push(
+                "layout: the stability budget ran out before other layouts of the same voxels could be tried"
+                    .to_string(),
+            );
         } else {
             repairs.push(format!(
-                "layout: none of {RESEEDS} other layouts of the same voxels did better"
+                "layout: none of {tried} other layout{} of the same voxels did better",
+                if tried == 1 { "" } else { "s" }
             ));
         }
     }
@@ -275,7 +283,10 @@ pub fn settle(
         }
     }
     let mut on_baseplate = None;
-    if best.check.first_failure.is_some() && params.ground == Ground::Table {
+    if best.check.first_failure.is_some()
+        && params.ground == Ground::Table
+        && Instant::now() < deadline
+    {
         // What a person can still do: build on a baseplate, whose studs
         // hold the bottom course.
         let base = Params {
@@ -375,7 +386,10 @@ fn attempt(
     counts.add(&check);
     let mut order_fix = None;
     let mut order_tried = None;
-    if let (true, true, Some(step)) = (repair, check.last.stands(), check.first_failure) {
+    let in_time = Instant::now() < deadline;
+    if let (true, true, true, Some(step)) =
+        (repair, in_time, check.last.stands(), check.first_failure)
+    {
         order_tried = Some(step);
         if let Some(r) = reorder(&plan.1, params, step, Some(deadline))? {
             counts.solves += r.solves;
@@ -660,7 +674,12 @@ fn failure_line(assembly: &Assembly, check: &StepsAnalysis) -> String {
         return String::new();
     };
     let at = check.steps.iter().find(|s| s.step == step);
-    let weak = at.map(|s| s.weakest.clone()).unwrap_or_default();
+    // A step not checked (past the budget) is the finished model, known
+    // to fail: its weakest pieces.
+    let weak = at.map_or_else(
+        || check.last.weakest(crate::physics::WEAKEST),
+        |s| s.weakest.clone(),
+    );
     let listed: Vec<String> = weak
         .iter()
         .take(3)
