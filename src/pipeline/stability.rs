@@ -58,6 +58,10 @@ impl Stability {
     }
 }
 
+/// The order repair may take at most this share (one over it) of the
+/// time left.
+const ORDER_SHARE: u32 = 4;
+
 /// Other layouts the repair tries when the finished model fails.
 pub const RESEEDS: u64 = 3;
 
@@ -190,8 +194,8 @@ pub fn settle(
     )?;
     let before = Before {
         first_failure: first.check.first_failure,
-        min_score: first.check.last.min_score,
-        final_stands: first.check.last.stands(),
+        min_score: first.finished.as_ref().map_or(0.0, |f| f.min_score),
+        final_stands: first.finished.as_ref().is_some_and(Analysis::stands),
     };
     let mut best = first;
     let mut reseeded = None;
@@ -216,12 +220,15 @@ pub fn settle(
             let last = analyze(&planned.1, params)?;
             counts.solves += 1;
             if !last.stands()
-                && (best.check.last.stands() || last.min_score <= best.check.last.min_score)
+                && ({
+                    let f = best.finished(params, &mut counts)?;
+                    f.stands() || last.min_score <= f.min_score
+                })
             {
                 continue;
             }
-            let candidate = attempt(planned, params, true, deadline, &mut counts, None)?;
-            if candidate.better_than(&best) {
+            let mut candidate = attempt(planned, params, true, deadline, &mut counts, None)?;
+            if candidate.better_than(&mut best, params, &mut counts)? {
                 best = candidate;
                 reseeded = Some(other);
                 shored = Shoring::default();
@@ -282,6 +289,8 @@ pub fn settle(
             ));
         }
     }
+    // A check that stopped at its first failure: the rest of it.
+    complete(&mut best, params, deadline, &mut counts)?;
     let mut on_baseplate = None;
     if best.check.first_failure.is_some()
         && params.ground == Ground::Table
@@ -339,6 +348,11 @@ impl Counts {
 struct Attempt {
     plan: Plan,
     check: StepsAnalysis,
+    /// `check` stopped at its first failure before the end: its `last` is
+    /// the failing structure.
+    partial: bool,
+    /// The finished model's analysis, once made.
+    finished: Option<Analysis>,
     /// The pieces the order repair moved, when it was kept.
     order_fix: Option<Vec<Moved>>,
     /// The step the order repair tried and could not fix.
@@ -352,9 +366,32 @@ impl Attempt {
     /// model's own pieces built before the first failure (counted in
     /// pieces, not steps: support columns add steps), then a higher lowest
     /// score.
-    fn better_than(&self, other: &Attempt) -> bool {
-        let key = |a: &Attempt| (a.check.last.stands(), a.progress(), a.check.last.min_score);
-        key(self).partial_cmp(&key(other)) == Some(std::cmp::Ordering::Greater)
+    fn better_than(
+        &mut self,
+        other: &mut Attempt,
+        params: &Params,
+        counts: &mut Counts,
+    ) -> Result<bool, crate::pipeline::BuildError> {
+        let mut key = |a: &mut Attempt| -> Result<_, crate::pipeline::BuildError> {
+            let progress = a.progress();
+            let f = a.finished(params, counts)?;
+            Ok((f.stands(), progress, f.min_score))
+        };
+        let (a, b) = (key(self)?, key(other)?);
+        Ok(a.partial_cmp(&b) == Some(std::cmp::Ordering::Greater))
+    }
+
+    /// The finished model's analysis, made if not yet.
+    fn finished(
+        &mut self,
+        params: &Params,
+        counts: &mut Counts,
+    ) -> Result<&Analysis, crate::pipeline::BuildError> {
+        if self.finished.is_none() {
+            counts.solves += 1;
+            self.finished = Some(analyze(&self.plan.1, params)?);
+        }
+        Ok(self.finished.as_ref().expect("just made"))
     }
 
     /// The model's own pieces (not support columns) in the steps before
@@ -372,7 +409,10 @@ impl Attempt {
 }
 
 /// Checks every step of `plan` and, when `repair` and only the steps
-/// before the end fail, tries the order repair on it.
+/// before the end fail, tries the order repair on it. A check for a
+/// repair stops at the first failure, which is what the repairs work on
+/// (the rest is checked at the end, see [`complete`]); the finished model
+/// is then analysed on its own.
 fn attempt(
     plan: Plan,
     params: &Params,
@@ -382,23 +422,35 @@ fn attempt(
     tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
-    let mut check = analyze_steps_told(&plan.1, params, false, Some(deadline), 1, tell)?;
+    let mut check = analyze_steps_told(&plan.1, params, repair, Some(deadline), 1, tell)?;
     counts.add(&check);
+    let mut partial = stopped_early(&plan.1, &check);
+    let finished = if partial {
+        counts.solves += 1;
+        analyze(&plan.1, params)?
+    } else {
+        check.last.clone()
+    };
+    let stands = finished.stands();
     let mut order_fix = None;
     let mut order_tried = None;
     let in_time = Instant::now() < deadline;
-    if let (true, true, true, Some(step)) =
-        (repair, in_time, check.last.stands(), check.first_failure)
-    {
+    if let (true, true, true, Some(step)) = (repair, in_time, stands, check.first_failure) {
         order_tried = Some(step);
-        if let Some(r) = reorder(&plan.1, params, step, Some(deadline))? {
+        // The order repair walks the later steps with an analysis each:
+        // on a big build it may not finish, and must leave time for the
+        // support columns.
+        let now = Instant::now();
+        let share = now + deadline.saturating_duration_since(now) / ORDER_SHARE;
+        if let Some(r) = reorder(&plan.1, params, step, Some(share))? {
             counts.solves += r.solves;
             if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
-                let c = analyze_steps_within(&r.assembly, params, false, Some(deadline))?;
+                let c = analyze_steps_within(&r.assembly, params, true, Some(deadline))?;
                 counts.add(&c);
                 if c.complete && later(c.first_failure, check.first_failure) {
                     order_fix = Some(r.moved);
                     plan.1 = r.assembly;
+                    partial = stopped_early(&plan.1, &c);
                     check = c;
                 }
             }
@@ -407,10 +459,49 @@ fn attempt(
     Ok(Attempt {
         plan,
         check,
+        partial,
+        finished: Some(finished),
         order_fix,
         order_tried,
         supports: Vec::new(),
     })
+}
+
+/// Whether `check` stopped at a failure before the last step of `asm`
+/// (its `last` is then the failing structure, not the finished model).
+fn stopped_early(asm: &Assembly, check: &StepsAnalysis) -> bool {
+    let last_step = asm.pieces.last().map_or(0, |p| p.step.0);
+    check.complete && check.first_failure.is_some_and(|f| f < last_step)
+}
+
+/// Completes a check that stopped at its first failure: the steps after
+/// it, and the finished model as its `last`; past the deadline, only the
+/// finished model's analysis (known already) takes `last`'s place.
+fn complete(
+    best: &mut Attempt,
+    params: &Params,
+    deadline: Instant,
+    counts: &mut Counts,
+) -> Result<(), crate::pipeline::BuildError> {
+    if !best.partial {
+        return Ok(());
+    }
+    let Some(from) = best.check.first_failure else {
+        return Ok(());
+    };
+    if Instant::now() < deadline {
+        let c = analyze_steps_from(&best.plan.1, params, false, Some(deadline), from)?;
+        counts.add(&c);
+        if c.first_failure.is_some() {
+            best.check = spliced(&best.check, from, c);
+            best.partial = false;
+            return Ok(());
+        }
+    }
+    best.check.last = best.finished(params, counts)?.clone();
+    best.check.complete = false;
+    best.partial = false;
+    Ok(())
 }
 
 /// The columns' footprints in words: "3 of 2 x 2, 1 of 1 x 1".
@@ -452,9 +543,6 @@ fn support(
         columns: Vec::new(),
         color: Some(color),
     };
-    // Whether `best.check` stops at its first failure (no later rows, and
-    // `last` is the failing structure, not the finished model).
-    let mut partial = false;
     while Instant::now() < deadline && kept.columns.len() < MAX_COLUMNS {
         let Some(target) = best.check.first_failure else {
             break;
@@ -506,10 +594,13 @@ fn support(
             .order_fix
             .as_ref()
             .map(|m| renumbered(m, asm, &shored.assembly, &supports));
-        let stops = c.first_failure.is_some();
+        let partial = stopped_early(&shored.assembly, &c);
+        let finished = (c.first_failure.is_none()).then(|| c.last.clone());
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: spliced(&best.check, from, c),
+            partial,
+            finished,
             order_fix,
             order_tried: best.order_tried,
             supports,
@@ -518,16 +609,7 @@ fn support(
             break;
         }
         *best = candidate;
-        partial = stops;
         kept.columns.extend(shored.columns);
-    }
-    if partial {
-        // What still fails: check the rest, the finished model included.
-        if let Some(from) = best.check.first_failure {
-            let c = analyze_steps_from(&best.plan.1, params, false, Some(deadline), from)?;
-            counts.add(&c);
-            best.check = spliced(&best.check, from, c);
-        }
     }
     steps_of(&best.plan.1, &mut kept.columns);
     Ok(kept)
