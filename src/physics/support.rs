@@ -34,7 +34,7 @@ use serde::Serialize;
 use super::model::{solve_propped, Prop, Props, Structure};
 use super::{analyze, Params, PhysicsError};
 use crate::assembly::verify::{verify, Failure};
-use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS};
+use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_PIECES};
 use crate::catalog::{Color, PartKind};
 use crate::geom::{Body, Cell, Rot};
 
@@ -510,24 +510,43 @@ fn plan(
     Ok(chosen)
 }
 
-/// `asm` with the `chosen` columns added in a step of their own just
-/// before the step of the pieces they hold (columns holding pieces of one
-/// step share it; past [`MAX_STEPS`], they join that step instead).
+/// `asm` with the `chosen` columns added in steps of their own just
+/// before the step of the pieces they hold: the columns holding pieces of
+/// one step share steps of at most [`STEP_PIECES`] pieces, whole columns
+/// together where they fit, a taller column in balanced parts, bottom up
+/// (see [`column_steps`]); past [`MAX_STEPS`], they join the step they
+/// hold instead.
 fn insert(
     asm: &Assembly,
     chosen: &[Candidate],
     color: Color,
 ) -> (Assembly, Vec<Column>, Vec<Placement>) {
     let bodies_z: Vec<i32> = asm.pieces.iter().map(|p| p.placement.origin.z).collect();
-    // Columns by the step they hold up.
-    let mut by_step: std::collections::BTreeMap<u32, Vec<&Candidate>> = Default::default();
-    for c in chosen {
+    // Each column's pieces, bottom up.
+    let parts: Vec<Vec<(PartKind, Rot, i32)>> = chosen
+        .iter()
+        .map(|c| {
+            let (_, _, sx, sy) = c.foot;
+            fill(asm.layer_ldu, bodies_z[c.piece] - c.bottom, sx, sy).unwrap_or_default()
+        })
+        .collect();
+    // Columns by the step they hold up, and the steps they take there.
+    let mut by_step: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    for (k, c) in chosen.iter().enumerate() {
         by_step
             .entry(asm.pieces[c.piece].step.0)
             .or_default()
-            .push(c);
+            .push(k);
     }
-    let own_steps = asm.step_count() as usize + by_step.len() <= MAX_STEPS;
+    let plans: std::collections::BTreeMap<u32, (Vec<Vec<u32>>, u32)> = by_step
+        .iter()
+        .map(|(&s, ks)| {
+            let sizes: Vec<usize> = ks.iter().map(|&k| parts[k].len()).collect();
+            (s, column_steps(&sizes, STEP_PIECES))
+        })
+        .collect();
+    let added: u32 = plans.values().map(|(_, n)| n).sum();
+    let own_steps = asm.step_count() as usize + added as usize <= MAX_STEPS;
     let mut pieces: Vec<Placed> = Vec::with_capacity(asm.pieces.len() + 4 * chosen.len());
     let mut columns = Vec::new();
     let mut placed = Vec::new();
@@ -536,20 +555,19 @@ fn insert(
     for p in &asm.pieces {
         if last_step != Some(p.step.0) {
             last_step = Some(p.step.0);
-            if let Some(cs) = by_step.get(&p.step.0) {
-                if own_steps {
-                    shift += 1;
-                }
-                for c in cs {
-                    let top = bodies_z[c.piece] - 1;
+            if let (Some(ks), Some((at, n))) = (by_step.get(&p.step.0), plans.get(&p.step.0)) {
+                // The first step of the columns: the held step's own
+                // number when they join it.
+                let first = p.step.0 + shift;
+                for (&k, at) in ks.iter().zip(at) {
+                    let c = &chosen[k];
                     let (x0, y0, sx, sy) = c.foot;
-                    let parts = fill(asm.layer_ldu, top + 1 - c.bottom, sx, sy).unwrap_or_default();
                     let mut z = c.bottom;
-                    for &(part, rot, h) in &parts {
+                    for (&(part, rot, h), &j) in parts[k].iter().zip(at) {
                         let placement = Placement::new(part, Cell::new(x0, y0, z), rot);
                         pieces.push(Placed {
                             placement,
-                            step: Step(p.step.0 + shift - u32::from(own_steps)),
+                            step: Step(first + if own_steps { j } else { 0 }),
                             color,
                         });
                         placed.push(placement);
@@ -560,11 +578,19 @@ fn insert(
                         y: y0,
                         size: [sx, sy],
                         bottom: c.bottom,
-                        top,
-                        step: p.step.0 + shift - u32::from(own_steps),
+                        top: bodies_z[c.piece] - 1,
+                        step: first
+                            + if own_steps {
+                                at.first().copied().unwrap_or(0)
+                            } else {
+                                0
+                            },
                         on_ground: c.lands_on.is_none(),
-                        pieces: parts.len(),
+                        pieces: parts[k].len(),
                     });
+                }
+                if own_steps {
+                    shift += n;
                 }
             }
         }
@@ -581,6 +607,40 @@ fn insert(
         columns,
         placed,
     )
+}
+
+/// The steps of columns of `sizes` pieces built one after the other, at
+/// most `cap` pieces a step: for each column, the step (from 0) of each
+/// of its pieces, bottom up, and the number of steps. A column joins the
+/// step before when both fit in it; a column of more than `cap` pieces
+/// takes steps of its own, its pieces shared out evenly among them.
+fn column_steps(sizes: &[usize], cap: usize) -> (Vec<Vec<u32>>, u32) {
+    let cap = cap.max(1);
+    let mut out = Vec::with_capacity(sizes.len());
+    // The step being filled and its pieces so far.
+    let (mut step, mut held) = (0u32, 0usize);
+    for &n in sizes {
+        if held > 0 && held + n > cap {
+            step += 1;
+            held = 0;
+        }
+        if n <= cap {
+            out.push(vec![step; n]);
+            held += n;
+            continue;
+        }
+        let k = n.div_ceil(cap);
+        let mut at = Vec::with_capacity(n);
+        for i in 0..k {
+            let len = n / k + usize::from(i < n % k);
+            at.extend(std::iter::repeat_n(step, len));
+            step += 1;
+        }
+        out.push(at);
+        held = 0;
+    }
+    let steps = if held > 0 { step + 1 } else { step };
+    (out, steps.max(u32::from(!sizes.is_empty())))
 }
 
 /// Sets each column's step from where its bottom piece is in `asm`
@@ -693,6 +753,25 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(again.assembly, shored.assembly);
+    }
+
+    #[test]
+    fn columns_share_steps_of_a_builders_size() {
+        // Whole columns together where they fit, bottom up.
+        assert_eq!(
+            column_steps(&[3, 2, 4], 8),
+            (vec![vec![0; 3], vec![0; 2], vec![1; 4]], 2)
+        );
+        // Four columns of five: a column a step.
+        let (at, n) = column_steps(&[5; 4], 8);
+        assert_eq!(n, 4);
+        assert_eq!(at[3], vec![3; 5]);
+        // A tall column in balanced parts, the next column after it.
+        assert_eq!(
+            column_steps(&[11, 2], 8),
+            (vec![vec![0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1], vec![2, 2]], 3)
+        );
+        assert_eq!(column_steps(&[1], 8), (vec![vec![0]], 1));
     }
 
     #[test]
