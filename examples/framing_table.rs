@@ -136,8 +136,9 @@ fn row(a: &Args, mesh: &Path, studs: u32, out: &Path) -> Result<String> {
         .as_array()
         .into_iter()
         .flatten()
-        .filter_map(|c| c["step"].as_u64())
-        .map(|s| (s as u32, brickwright::pipeline::SUPPORT_NOTE.to_string()))
+        .filter_map(|c| Some((c["step"].as_u64()?, c["last_step"].as_u64()?)))
+        .flat_map(|(a, b)| a as u32..=b as u32)
+        .map(|s| (s, brickwright::pipeline::SUPPORT_NOTE.to_string()))
         .collect();
     let p = measure::pages(&asm, &r, &images, &notes);
     let list = |v: &[usize]| {

@@ -119,7 +119,7 @@ fn check(fixture: &str, studs: u32, stability: Stability) {
         .stability
         .iter()
         .flat_map(|s| &s.supports)
-        .map(|c| (c.step, pipeline::SUPPORT_NOTE.to_string()))
+        .flat_map(|c| (c.step..=c.last_step).map(|s| (s, pipeline::SUPPORT_NOTE.to_string())))
         .collect();
     let p = measure::pages(a, &r, &images, &notes);
     let (median, tenth) = (quantile(&p.shares, 0.5), quantile(&p.shares, 0.1));

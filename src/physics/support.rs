@@ -17,8 +17,9 @@
 //!    needs less force than one near its root, so the price picks it);
 //! 3. the columns carrying the most force become real pieces: bricks
 //!    (topped with plates where the grid is a plate high) 2 x 2 where
-//!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in a step of their
-//!    own just before the piece they hold;
+//!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in steps of their
+//!    own (at most [`STEP_PIECES`] pieces each) just before the piece they
+//!    hold;
 //! 4. the structure is analysed again, and the rounds repeat until it
 //!    stands, or [`MAX_COLUMNS`] columns are in, or 12 rounds have run, or
 //!    the deadline passes.
@@ -78,9 +79,12 @@ pub struct Column {
     pub bottom: i32,
     /// Highest layer it fills.
     pub top: i32,
-    /// The step that adds it (its own, just before the step of the piece
-    /// it holds).
+    /// The step that adds it, or its first piece when it takes several
+    /// (its own, just before the step of the piece it holds).
     pub step: u32,
+    /// The step that adds its top piece: `step` unless the column is
+    /// taller than a step holds.
+    pub last_step: u32,
     /// Whether it stands on the ground (else on a piece).
     pub on_ground: bool,
     /// Pieces it is made of.
@@ -585,6 +589,12 @@ fn insert(
                             } else {
                                 0
                             },
+                        last_step: first
+                            + if own_steps {
+                                at.last().copied().unwrap_or(0)
+                            } else {
+                                0
+                            },
                         on_ground: c.lands_on.is_none(),
                         pieces: parts[k].len(),
                     });
@@ -643,8 +653,8 @@ fn column_steps(sizes: &[usize], cap: usize) -> (Vec<Vec<u32>>, u32) {
     (out, steps.max(u32::from(!sizes.is_empty())))
 }
 
-/// Sets each column's step from where its bottom piece is in `asm`
-/// (later rounds renumber the steps), and puts them in build order.
+/// Sets each column's steps from where its pieces are in `asm` (later
+/// rounds renumber the steps), and puts them in build order.
 pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
     let at: HashMap<Cell, u32> = asm
         .pieces
@@ -652,8 +662,14 @@ pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
         .map(|p| (p.placement.origin, p.step.0))
         .collect();
     for c in columns.iter_mut() {
-        if let Some(&s) = at.get(&Cell::new(c.x, c.y, c.bottom)) {
-            c.step = s;
+        // Its pieces: those whose corner is on its corner, bottom to top
+        // (only the column fills those cells).
+        let steps: Vec<u32> = (c.bottom..=c.top)
+            .filter_map(|z| at.get(&Cell::new(c.x, c.y, z)).copied())
+            .collect();
+        if let (Some(&first), Some(&last)) = (steps.first(), steps.iter().max()) {
+            c.step = first;
+            c.last_step = last;
         }
     }
     columns.sort_by_key(|c| (c.step, c.bottom, c.y, c.x));
