@@ -97,8 +97,10 @@ impl Assembly {
     /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep
     /// within [`MAX_STEPS`]; a run of fewer than [`STEP_MIN_PIECES`] (a
     /// piece that hangs from the course above comes after it, between two
-    /// runs) joins the smaller of its neighbours when the two fit in one
-    /// step (see [`merge_runs`]); `Each` one piece a step; `Size(n)` n pieces a
+    /// runs) joins the smaller of its neighbours on the next course when
+    /// the two fit in one step, or else shares that neighbour's pieces in
+    /// halves, and what is still small joins a neighbour across three
+    /// courses (see `merge_runs`); `Each` one piece a step; `Size(n)` n pieces a
     /// step; `Layer` one step per course run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
         let layer_ldu = self.layer_ldu;
