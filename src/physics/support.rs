@@ -35,7 +35,7 @@ use serde::Serialize;
 use super::model::{solve_propped, Prop, Props, Structure};
 use super::{analyze, Params, PhysicsError};
 use crate::assembly::verify::{verify, Failure};
-use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_PIECES};
+use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_MIN_PIECES, STEP_PIECES};
 use crate::catalog::{Color, PartKind};
 use crate::geom::{Body, Cell, Rot};
 
@@ -518,8 +518,9 @@ fn plan(
 /// before the step of the pieces they hold: the columns holding pieces of
 /// one step share steps of at most [`STEP_PIECES`] pieces, whole columns
 /// together where they fit, a taller column in balanced parts, bottom up
-/// (see [`column_steps`]); past [`MAX_STEPS`], they join the step they
-/// hold instead.
+/// (see [`column_steps`]), and a first such step of one or two pieces
+/// joins the step before when it has room; past [`MAX_STEPS`], they join
+/// the step they hold instead.
 fn insert(
     asm: &Assembly,
     chosen: &[Candidate],
@@ -542,11 +543,28 @@ fn insert(
             .or_default()
             .push(k);
     }
+    // Pieces a step holds.
+    let mut held: HashMap<u32, usize> = HashMap::new();
+    for p in &asm.pieces {
+        *held.entry(p.step.0).or_default() += 1;
+    }
+    // Each step's plan: the step of each column piece, from 0, and the
+    // steps they take; a first step of one or two pieces joins the step
+    // before when that has room (their pieces come right after its own).
     let plans: std::collections::BTreeMap<u32, (Vec<Vec<u32>>, u32)> = by_step
         .iter()
         .map(|(&s, ks)| {
             let sizes: Vec<usize> = ks.iter().map(|&k| parts[k].len()).collect();
-            (s, column_steps(&sizes, STEP_PIECES))
+            let (at, n) = column_steps(&sizes, STEP_PIECES);
+            let first = at.iter().flatten().filter(|&&j| j == 0).count();
+            let before = held.get(&s.wrapping_sub(1)).copied().unwrap_or(0);
+            let join =
+                s > 1 && first < STEP_MIN_PIECES && before > 0 && before + first <= STEP_PIECES;
+            let at = at
+                .into_iter()
+                .map(|a| a.into_iter().map(|j| j + u32::from(!join)).collect())
+                .collect();
+            (s, (at, n - u32::from(join)))
         })
         .collect();
     let added: u32 = plans.values().map(|(_, n)| n).sum();
@@ -560,9 +578,11 @@ fn insert(
         if last_step != Some(p.step.0) {
             last_step = Some(p.step.0);
             if let (Some(ks), Some((at, n))) = (by_step.get(&p.step.0), plans.get(&p.step.0)) {
-                // The first step of the columns: the held step's own
-                // number when they join it.
-                let first = p.step.0 + shift;
+                // The step before the held one (its number once the
+                // columns are in): the columns' steps count from it.
+                let first = p.step.0 + shift - 1;
+                // Past LeoCAD's steps, all in the held step.
+                let step_of = |j: u32| if own_steps { first + j } else { first + 1 };
                 for (&k, at) in ks.iter().zip(at) {
                     let c = &chosen[k];
                     let (x0, y0, sx, sy) = c.foot;
@@ -571,7 +591,7 @@ fn insert(
                         let placement = Placement::new(part, Cell::new(x0, y0, z), rot);
                         pieces.push(Placed {
                             placement,
-                            step: Step(first + if own_steps { j } else { 0 }),
+                            step: Step(step_of(j)),
                             color,
                         });
                         placed.push(placement);
@@ -583,18 +603,8 @@ fn insert(
                         size: [sx, sy],
                         bottom: c.bottom,
                         top: bodies_z[c.piece] - 1,
-                        step: first
-                            + if own_steps {
-                                at.first().copied().unwrap_or(0)
-                            } else {
-                                0
-                            },
-                        last_step: first
-                            + if own_steps {
-                                at.last().copied().unwrap_or(0)
-                            } else {
-                                0
-                            },
+                        step: step_of(at.first().copied().unwrap_or(1)),
+                        last_step: step_of(at.last().copied().unwrap_or(1)),
                         on_ground: c.lands_on.is_none(),
                         pieces: parts[k].len(),
                     });
@@ -769,6 +779,34 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(again.assembly, shored.assembly);
+    }
+
+    #[test]
+    fn a_short_column_joins_the_step_before() {
+        // The gallows a brick lower: a column of two pieces, which joins
+        // the post's top brick's step rather than make a step of two.
+        let params = Params::default();
+        let asm = Assembly {
+            pieces: vec![
+                piece("3005", 0, 0, 1),
+                piece("3005", 0, 1, 2),
+                piece("3009", 0, 2, 3),
+            ],
+            layer_ldu: 24,
+        };
+        assert!(!analyze(&asm, &params).unwrap().stands());
+        let shored = shore_up(&asm, &params, None, 0, Color(71), None)
+            .unwrap()
+            .expect("a column");
+        assert!(shored.stands);
+        let check = analyze_steps(&shored.assembly, &params, false).unwrap();
+        assert_eq!(check.first_failure, None, "{check:?}");
+        assert!(verify(&shored.assembly, None).is_ok());
+        assert_eq!(shored.columns.len(), 1);
+        let c = &shored.columns[0];
+        assert_eq!((c.pieces, c.step, c.last_step), (2, 2, 2), "{c:?}");
+        let steps: Vec<u32> = shored.assembly.pieces.iter().map(|p| p.step.0).collect();
+        assert_eq!(steps, [1, 2, 2, 2, 3]);
     }
 
     #[test]
