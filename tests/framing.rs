@@ -5,10 +5,11 @@
 //!   bounding box (its non-white pixels) fills most of the frame (larger
 //!   side at least 60% of the frame's in the median step, 45% in the
 //!   lowest tenth), and never touches the frame's edge (nothing new is
-//!   cut off); the scale changes rarely, by a quarter or more each time;
+//!   cut off, and the "turn the model" badge covers no new piece); the
+//!   scale changes rarely, by a quarter or more each time;
 //! - steps: 3 to 8 new pieces a step (mean at least 3 on models of 100
-//!   pieces or more), the steps numbered 1, 2, 3, ... in the order of the
-//!   pieces;
+//!   pieces or more, at least 80% of the steps between 3 and 8), the
+//!   steps numbered 1, 2, 3, ... in the order of the pieces;
 //! - the page: the booklet's step pictures, cut to the model, are mostly
 //!   model (little white around it), no model pixel runs under a step's
 //!   number or callout, nothing overlaps or leaves its cell or the page,
