@@ -97,8 +97,10 @@ impl Assembly {
     /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep
     /// within [`MAX_STEPS`]; a run of fewer than [`STEP_MIN_PIECES`] (a
     /// piece that hangs from the course above comes after it, between two
-    /// runs) joins the smaller of its neighbours when the two fit in one
-    /// step; `Each` one piece a step; `Size(n)` n pieces a
+    /// runs) joins the smaller of its neighbours on the next course when
+    /// the two fit in one step, or else shares that neighbour's pieces in
+    /// halves, and what is still small joins a neighbour across three
+    /// courses (see `merge_runs`); `Each` one piece a step; `Size(n)` n pieces a
     /// step; `Layer` one step per course run.
     pub fn regroup(&mut self, grouping: StepGrouping) {
         let layer_ldu = self.layer_ldu;
@@ -134,10 +136,10 @@ impl Assembly {
                         .collect()
                 };
                 let mut cap = STEP_PIECES;
-                let mut sizes = merge_small(split(cap), cap, &courses);
+                let mut sizes = merge_runs(split(cap), cap, &courses);
                 while sizes.len() > MAX_STEPS && cap < self.pieces.len() {
                     cap += 1;
-                    sizes = merge_small(split(cap), cap, &courses);
+                    sizes = merge_runs(split(cap), cap, &courses);
                 }
                 if sizes.len() > MAX_STEPS {
                     // More course runs than LeoCAD shows: merge runs.
@@ -255,27 +257,38 @@ pub const STEP_PIECES: usize = 8;
 /// join a neighbouring step (see [`Assembly::regroup`]).
 pub const STEP_MIN_PIECES: usize = 3;
 
+/// Joins the groups of fewer than [`STEP_MIN_PIECES`] to a neighbour
+/// (see [`merge_small`]) on at most two neighbouring courses, then those
+/// that could join none on at most three: a model that goes back and
+/// forth between courses (pieces hanging from the course above, between
+/// runs of the courses below and above) is not left in steps of one or
+/// two pieces.
+fn merge_runs(sizes: Vec<usize>, cap: usize, courses: &[i32]) -> Vec<usize> {
+    let sizes = merge_small(sizes, cap, courses, 1);
+    merge_small(sizes, cap, courses, 2)
+}
+
 /// Joins each group of fewer than [`STEP_MIN_PIECES`] to the smaller of
 /// its neighbours (the one before on a tie) when the two hold at most
-/// `cap` pieces on at most two neighbouring courses (`courses[i]` is
-/// piece `i`'s), until none can join; the order of pieces is unchanged.
-fn merge_small(mut sizes: Vec<usize>, cap: usize, courses: &[i32]) -> Vec<usize> {
+/// `cap` pieces whose courses are at most `reach` apart (`courses[i]` is
+/// piece `i`'s); when they hold more than `cap`, the two share their
+/// pieces in halves instead (a piece hanging under a full step of the
+/// course above: 8 + 1 becomes 5 + 4). Until no group changes; the order
+/// of pieces is unchanged.
+fn merge_small(mut sizes: Vec<usize>, cap: usize, courses: &[i32], reach: i32) -> Vec<usize> {
     // Each group's lowest and highest course.
     let mut span: Vec<(i32, i32)> = Vec::with_capacity(sizes.len());
     let mut at = 0;
     for &n in &sizes {
-        let c = &courses[at..at + n];
-        span.push((
-            c.iter().copied().min().unwrap_or(0),
-            c.iter().copied().max().unwrap_or(0),
-        ));
+        span.push(course_span(&courses[at..at + n]));
         at += n;
     }
     let joined = |a: (i32, i32), b: (i32, i32)| (a.0.min(b.0), a.1.max(b.1));
-    let fits = |a: (i32, i32), b: (i32, i32), n: usize| {
+    let near = |a: (i32, i32), b: (i32, i32)| {
         let (lo, hi) = joined(a, b);
-        n <= cap && hi - lo <= 1
+        hi - lo <= reach
     };
+    let fits = |a: (i32, i32), b: (i32, i32), n: usize| n <= cap && near(a, b);
     loop {
         let mut changed = false;
         let mut i = 0;
@@ -305,13 +318,49 @@ fn merge_small(mut sizes: Vec<usize>, cap: usize, courses: &[i32]) -> Vec<usize>
                     span.remove(i + 1);
                     changed = true;
                 }
-                _ => i += 1,
+                _ => {
+                    // Too many for one step: the group takes pieces from
+                    // the smaller neighbour it may share a step with,
+                    // the two halves of their pieces.
+                    let before = (i > 0)
+                        .then(|| sizes[i - 1])
+                        .filter(|&n| n + sizes[i] >= 2 * STEP_MIN_PIECES)
+                        .filter(|_| near(span[i - 1], span[i]));
+                    let after = (i + 1 < sizes.len())
+                        .then(|| sizes[i + 1])
+                        .filter(|&n| n + sizes[i] >= 2 * STEP_MIN_PIECES)
+                        .filter(|_| near(span[i + 1], span[i]));
+                    let (a, b) = match (before, after) {
+                        (Some(b), a) if a.is_none_or(|a| b <= a) => (i - 1, i),
+                        (_, Some(_)) => (i, i + 1),
+                        _ => {
+                            i += 1;
+                            continue;
+                        }
+                    };
+                    let total = sizes[a] + sizes[b];
+                    let start: usize = sizes[..a].iter().sum();
+                    // The earlier group keeps the larger half.
+                    sizes[b] = total / 2;
+                    sizes[a] = total - total / 2;
+                    span[a] = course_span(&courses[start..start + sizes[a]]);
+                    span[b] = course_span(&courses[start + sizes[a]..start + total]);
+                    changed = true;
+                }
             }
         }
         if !changed {
             return sizes;
         }
     }
+}
+
+/// The lowest and highest of `courses`.
+fn course_span(courses: &[i32]) -> (i32, i32) {
+    (
+        courses.iter().copied().min().unwrap_or(0),
+        courses.iter().copied().max().unwrap_or(0),
+    )
 }
 
 /// Steps LeoCAD shows at most (its step counter is one byte); a model with
@@ -378,12 +427,21 @@ mod tests {
         };
         let m = |groups: &[(usize, i32)]| {
             let (sizes, c) = courses(groups);
-            merge_small(sizes, 8, &c)
+            merge_small(sizes, 8, &c, 1)
         };
         assert_eq!(m(&[(5, 0), (1, 1), (1, 0), (6, 1)]), vec![7, 6]);
         assert_eq!(m(&[(1, 0), (1, 1), (1, 0), (1, 1)]), vec![4]);
-        assert_eq!(m(&[(8, 0), (1, 1), (8, 2)]), vec![8, 1, 8]);
-        assert_eq!(m(&[(2, 0), (7, 1)]), vec![2, 7]);
+        // Too many for one step: the small group takes half of its
+        // neighbour's pieces (the one before on a tie).
+        assert_eq!(m(&[(8, 0), (1, 1), (8, 2)]), vec![5, 4, 8]);
+        assert_eq!(m(&[(8, 3), (1, 1), (8, 1)]), vec![8, 5, 4]);
+        assert_eq!(m(&[(2, 0), (7, 1)]), vec![5, 4]);
+        // Never across courses further apart.
+        assert_eq!(m(&[(1, 0), (8, 2)]), vec![1, 8]);
+        // Then what is still small joins across three courses.
+        assert_eq!(m(&[(4, 2), (2, 0), (4, 2)]), vec![4, 2, 4]);
+        let (sizes, c) = courses(&[(4, 2), (2, 0), (4, 2)]);
+        assert_eq!(merge_runs(sizes, 8, &c), vec![6, 4]);
         assert_eq!(m(&[(4, 0), (2, 1), (3, 2)]), vec![4, 5]);
         // A step spans at most two neighbouring courses.
         assert_eq!(m(&[(4, 0), (1, 2), (3, 4)]), vec![4, 1, 3]);

@@ -17,8 +17,9 @@
 //!    needs less force than one near its root, so the price picks it);
 //! 3. the columns carrying the most force become real pieces: bricks
 //!    (topped with plates where the grid is a plate high) 2 x 2 where
-//!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in a step of their
-//!    own just before the piece they hold;
+//!    there is room, else 2 x 1, 1 x 2 or 1 x 1, added in steps of their
+//!    own (at most [`STEP_PIECES`] pieces each) just before the piece they
+//!    hold;
 //! 4. the structure is analysed again, and the rounds repeat until it
 //!    stands, or [`MAX_COLUMNS`] columns are in, or 12 rounds have run, or
 //!    the deadline passes.
@@ -34,7 +35,7 @@ use serde::Serialize;
 use super::model::{solve_propped, Prop, Props, Structure};
 use super::{analyze, Params, PhysicsError};
 use crate::assembly::verify::{verify, Failure};
-use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS};
+use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_MIN_PIECES, STEP_PIECES};
 use crate::catalog::{Color, PartKind};
 use crate::geom::{Body, Cell, Rot};
 
@@ -78,9 +79,12 @@ pub struct Column {
     pub bottom: i32,
     /// Highest layer it fills.
     pub top: i32,
-    /// The step that adds it (its own, just before the step of the piece
-    /// it holds).
+    /// The step that adds it, or its first piece when it takes several
+    /// (its own, just before the step of the piece it holds).
     pub step: u32,
+    /// The step that adds its top piece: `step` unless the column is
+    /// taller than a step holds.
+    pub last_step: u32,
     /// Whether it stands on the ground (else on a piece).
     pub on_ground: bool,
     /// Pieces it is made of.
@@ -510,24 +514,61 @@ fn plan(
     Ok(chosen)
 }
 
-/// `asm` with the `chosen` columns added in a step of their own just
-/// before the step of the pieces they hold (columns holding pieces of one
-/// step share it; past [`MAX_STEPS`], they join that step instead).
+/// `asm` with the `chosen` columns added in steps of their own just
+/// before the step of the pieces they hold: the columns holding pieces of
+/// one step share steps of at most [`STEP_PIECES`] pieces, whole columns
+/// together where they fit, a taller column in balanced parts, bottom up
+/// (see [`column_steps`]), and a first such step of one or two pieces
+/// joins the step before when it has room; past [`MAX_STEPS`], they join
+/// the step they hold instead.
 fn insert(
     asm: &Assembly,
     chosen: &[Candidate],
     color: Color,
 ) -> (Assembly, Vec<Column>, Vec<Placement>) {
     let bodies_z: Vec<i32> = asm.pieces.iter().map(|p| p.placement.origin.z).collect();
-    // Columns by the step they hold up.
-    let mut by_step: std::collections::BTreeMap<u32, Vec<&Candidate>> = Default::default();
-    for c in chosen {
+    // Each column's pieces, bottom up.
+    let parts: Vec<Vec<(PartKind, Rot, i32)>> = chosen
+        .iter()
+        .map(|c| {
+            let (_, _, sx, sy) = c.foot;
+            fill(asm.layer_ldu, bodies_z[c.piece] - c.bottom, sx, sy).unwrap_or_default()
+        })
+        .collect();
+    // Columns by the step they hold up, and the steps they take there.
+    let mut by_step: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    for (k, c) in chosen.iter().enumerate() {
         by_step
             .entry(asm.pieces[c.piece].step.0)
             .or_default()
-            .push(c);
+            .push(k);
     }
-    let own_steps = asm.step_count() as usize + by_step.len() <= MAX_STEPS;
+    // Pieces a step holds.
+    let mut held: HashMap<u32, usize> = HashMap::new();
+    for p in &asm.pieces {
+        *held.entry(p.step.0).or_default() += 1;
+    }
+    // Each step's plan: the step of each column piece, from 0, and the
+    // steps they take; a first step of one or two pieces joins the step
+    // before when that has room (their pieces come right after its own).
+    let plans: std::collections::BTreeMap<u32, (Vec<Vec<u32>>, u32)> = by_step
+        .iter()
+        .map(|(&s, ks)| {
+            let sizes: Vec<usize> = ks.iter().map(|&k| parts[k].len()).collect();
+            let (at, n) = column_steps(&sizes, STEP_PIECES);
+            let first = at.iter().flatten().filter(|&&j| j == 0).count();
+            let before = held.get(&s.wrapping_sub(1)).copied().unwrap_or(0);
+            let join =
+                s > 1 && first < STEP_MIN_PIECES && before > 0 && before + first <= STEP_PIECES;
+            let at = at
+                .into_iter()
+                .map(|a| a.into_iter().map(|j| j + u32::from(!join)).collect())
+                .collect();
+            (s, (at, n - u32::from(join)))
+        })
+        .collect();
+    let added: u32 = plans.values().map(|(_, n)| n).sum();
+    let own_steps = asm.step_count() as usize + added as usize <= MAX_STEPS;
     let mut pieces: Vec<Placed> = Vec::with_capacity(asm.pieces.len() + 4 * chosen.len());
     let mut columns = Vec::new();
     let mut placed = Vec::new();
@@ -536,20 +577,21 @@ fn insert(
     for p in &asm.pieces {
         if last_step != Some(p.step.0) {
             last_step = Some(p.step.0);
-            if let Some(cs) = by_step.get(&p.step.0) {
-                if own_steps {
-                    shift += 1;
-                }
-                for c in cs {
-                    let top = bodies_z[c.piece] - 1;
+            if let (Some(ks), Some((at, n))) = (by_step.get(&p.step.0), plans.get(&p.step.0)) {
+                // The step before the held one (its number once the
+                // columns are in): the columns' steps count from it.
+                let first = p.step.0 + shift - 1;
+                // Past LeoCAD's steps, all in the held step.
+                let step_of = |j: u32| if own_steps { first + j } else { first + 1 };
+                for (&k, at) in ks.iter().zip(at) {
+                    let c = &chosen[k];
                     let (x0, y0, sx, sy) = c.foot;
-                    let parts = fill(asm.layer_ldu, top + 1 - c.bottom, sx, sy).unwrap_or_default();
                     let mut z = c.bottom;
-                    for &(part, rot, h) in &parts {
+                    for (&(part, rot, h), &j) in parts[k].iter().zip(at) {
                         let placement = Placement::new(part, Cell::new(x0, y0, z), rot);
                         pieces.push(Placed {
                             placement,
-                            step: Step(p.step.0 + shift - u32::from(own_steps)),
+                            step: Step(step_of(j)),
                             color,
                         });
                         placed.push(placement);
@@ -560,11 +602,15 @@ fn insert(
                         y: y0,
                         size: [sx, sy],
                         bottom: c.bottom,
-                        top,
-                        step: p.step.0 + shift - u32::from(own_steps),
+                        top: bodies_z[c.piece] - 1,
+                        step: step_of(at.first().copied().unwrap_or(1)),
+                        last_step: step_of(at.last().copied().unwrap_or(1)),
                         on_ground: c.lands_on.is_none(),
-                        pieces: parts.len(),
+                        pieces: parts[k].len(),
                     });
+                }
+                if own_steps {
+                    shift += n;
                 }
             }
         }
@@ -583,8 +629,42 @@ fn insert(
     )
 }
 
-/// Sets each column's step from where its bottom piece is in `asm`
-/// (later rounds renumber the steps), and puts them in build order.
+/// The steps of columns of `sizes` pieces built one after the other, at
+/// most `cap` pieces a step: for each column, the step (from 0) of each
+/// of its pieces, bottom up, and the number of steps. A column joins the
+/// step before when both fit in it; a column of more than `cap` pieces
+/// takes steps of its own, its pieces shared out evenly among them.
+fn column_steps(sizes: &[usize], cap: usize) -> (Vec<Vec<u32>>, u32) {
+    let cap = cap.max(1);
+    let mut out = Vec::with_capacity(sizes.len());
+    // The step being filled and its pieces so far.
+    let (mut step, mut held) = (0u32, 0usize);
+    for &n in sizes {
+        if held > 0 && held + n > cap {
+            step += 1;
+            held = 0;
+        }
+        if n <= cap {
+            out.push(vec![step; n]);
+            held += n;
+            continue;
+        }
+        let k = n.div_ceil(cap);
+        let mut at = Vec::with_capacity(n);
+        for i in 0..k {
+            let len = n / k + usize::from(i < n % k);
+            at.extend(std::iter::repeat_n(step, len));
+            step += 1;
+        }
+        out.push(at);
+        held = 0;
+    }
+    let steps = if held > 0 { step + 1 } else { step };
+    (out, steps.max(u32::from(!sizes.is_empty())))
+}
+
+/// Sets each column's steps from where its pieces are in `asm` (later
+/// rounds renumber the steps), and puts them in build order.
 pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
     let at: HashMap<Cell, u32> = asm
         .pieces
@@ -592,8 +672,14 @@ pub fn steps_of(asm: &Assembly, columns: &mut [Column]) {
         .map(|p| (p.placement.origin, p.step.0))
         .collect();
     for c in columns.iter_mut() {
-        if let Some(&s) = at.get(&Cell::new(c.x, c.y, c.bottom)) {
-            c.step = s;
+        // Its pieces: those whose corner is on its corner, bottom to top
+        // (only the column fills those cells).
+        let steps: Vec<u32> = (c.bottom..=c.top)
+            .filter_map(|z| at.get(&Cell::new(c.x, c.y, z)).copied())
+            .collect();
+        if let (Some(&first), Some(&last)) = (steps.first(), steps.iter().max()) {
+            c.step = first;
+            c.last_step = last;
         }
     }
     columns.sort_by_key(|c| (c.step, c.bottom, c.y, c.x));
@@ -693,6 +779,53 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(again.assembly, shored.assembly);
+    }
+
+    #[test]
+    fn a_short_column_joins_the_step_before() {
+        // The gallows a brick lower: a column of two pieces, which joins
+        // the post's top brick's step rather than make a step of two.
+        let params = Params::default();
+        let asm = Assembly {
+            pieces: vec![
+                piece("3005", 0, 0, 1),
+                piece("3005", 0, 1, 2),
+                piece("3009", 0, 2, 3),
+            ],
+            layer_ldu: 24,
+        };
+        assert!(!analyze(&asm, &params).unwrap().stands());
+        let shored = shore_up(&asm, &params, None, 0, Color(71), None)
+            .unwrap()
+            .expect("a column");
+        assert!(shored.stands);
+        let check = analyze_steps(&shored.assembly, &params, false).unwrap();
+        assert_eq!(check.first_failure, None, "{check:?}");
+        assert!(verify(&shored.assembly, None).is_ok());
+        assert_eq!(shored.columns.len(), 1);
+        let c = &shored.columns[0];
+        assert_eq!((c.pieces, c.step, c.last_step), (2, 2, 2), "{c:?}");
+        let steps: Vec<u32> = shored.assembly.pieces.iter().map(|p| p.step.0).collect();
+        assert_eq!(steps, [1, 2, 2, 2, 3]);
+    }
+
+    #[test]
+    fn columns_share_steps_of_a_builders_size() {
+        // Whole columns together where they fit, bottom up.
+        assert_eq!(
+            column_steps(&[3, 2, 4], 8),
+            (vec![vec![0; 3], vec![0; 2], vec![1; 4]], 2)
+        );
+        // Four columns of five: a column a step.
+        let (at, n) = column_steps(&[5; 4], 8);
+        assert_eq!(n, 4);
+        assert_eq!(at[3], vec![3; 5]);
+        // A tall column in balanced parts, the next column after it.
+        assert_eq!(
+            column_steps(&[11, 2], 8),
+            (vec![vec![0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1], vec![2, 2]], 3)
+        );
+        assert_eq!(column_steps(&[1], 8), (vec![vec![0]], 1));
     }
 
     #[test]

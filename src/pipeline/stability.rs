@@ -828,9 +828,10 @@ impl Settled {
         self.stability
             .iter()
             .flat_map(|(r, _)| &r.supports)
-            .map(|c| {
+            .flat_map(|c| {
+                // Every step of a column taller than a step holds.
                 let note = super::hollow::note(c, self.outcome.emptied.as_ref());
-                (c.step, note.to_string())
+                (c.step..=c.last_step.max(c.step)).map(move |s| (s, note.to_string()))
             })
             .collect()
     }

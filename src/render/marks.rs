@@ -131,13 +131,20 @@ pub(crate) fn badge_side(width: u32, height: u32) -> u32 {
 }
 
 /// Draws the "turn the model" badge for a view turned by `quarter_turns`
-/// (1 to 3) from the last step's, in the corner of `img` where the least
-/// differs from `background`: a curved arrow around a little block, as
+/// (1 to 3) from the last step's, in the corner of `img` that covers the
+/// least of `new` (the screen box of the step's new pieces: a badge never
+/// hides a new piece where a corner is free of them), and of those where
+/// the least differs from `background`: a curved arrow around a little block, as
 /// printed instructions show a turn. The arrow's front goes the way the
 /// model's front turns: to the left for one quarter turn (the viewer
 /// walks right, around to the model's right side), to the right for
 /// three, and with a double head for a half turn.
-pub(crate) fn draw_turn(img: &mut RgbaImage, quarter_turns: u8, background: [u8; 4]) {
+pub(crate) fn draw_turn(
+    img: &mut RgbaImage,
+    quarter_turns: u8,
+    background: [u8; 4],
+    new: PixelRect,
+) {
     let (w, h) = img.dimensions();
     let side = badge_side(w, h);
     if side + 2 > w || side + 2 > h {
@@ -151,10 +158,14 @@ pub(crate) fn draw_turn(img: &mut RgbaImage, quarter_turns: u8, background: [u8;
         (pad, h - side - pad),
     ];
     let busy = |&(x0, y0): &(u32, u32)| {
-        (y0..y0 + side)
+        let over =
+            |a0: u32, a1: u32, b0: u32, b1: u32| u64::from(a1.min(b1).saturating_sub(a0.max(b0)));
+        let hidden = over(x0, x0 + side, new.x0, new.x1) * over(y0, y0 + side, new.y0, new.y1);
+        let differ = (y0..y0 + side)
             .flat_map(|y| (x0..x0 + side).map(move |x| (x, y)))
             .filter(|&(x, y)| img.get_pixel(x, y).0 != background)
-            .count()
+            .count();
+        (hidden, differ)
     };
     let mut at = corners[0];
     let mut least = busy(&at);
@@ -309,7 +320,7 @@ mod tests {
             }
         }
         let before = img.clone();
-        draw_turn(&mut img, 1, [255; 4]);
+        draw_turn(&mut img, 1, [255; 4], PixelRect::EMPTY);
         let side = badge_side(200, 150);
         let changed = |x0: u32, y0: u32| {
             (y0..y0 + side)
@@ -322,11 +333,38 @@ mod tests {
     }
 
     #[test]
+    fn the_turn_badge_never_covers_the_new_pieces_when_a_corner_is_free() {
+        // The top left is empty but holds the new pieces' box; the top
+        // right is full of old pieces: the badge goes to a bottom corner.
+        let mut img = white(200, 150);
+        for y in 0..60 {
+            for x in 140..200 {
+                img.put_pixel(x, y, Rgba([0, 0, 0, 255]));
+            }
+        }
+        let new = PixelRect {
+            x0: 10,
+            y0: 5,
+            x1: 30,
+            y1: 25,
+        };
+        let before = img.clone();
+        draw_turn(&mut img, 1, [255; 4], new);
+        let side = badge_side(200, 150);
+        for y in 0..side {
+            for x in 0..side {
+                assert_eq!(img.get_pixel(x, y), before.get_pixel(x, y));
+            }
+        }
+        assert_ne!(img, before);
+    }
+
+    #[test]
     fn each_turn_draws_its_own_arrow() {
         let imgs: Vec<RgbaImage> = (1..=3)
             .map(|q| {
                 let mut img = white(200, 150);
-                draw_turn(&mut img, q, [255; 4]);
+                draw_turn(&mut img, q, [255; 4], PixelRect::EMPTY);
                 img
             })
             .collect();

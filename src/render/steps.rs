@@ -513,7 +513,7 @@ impl Iterator for StepImages<'_> {
         // composed on by the next step.
         let mut out = self.image.clone();
         if let Some(turned) = r.turn_at(n) {
-            draw_turn(&mut out, turned, r.style.background);
+            draw_turn(&mut out, turned, r.style.background, r.step_rect(n));
         }
         Some((r.steps[n].0, out))
     }
