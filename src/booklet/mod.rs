@@ -439,14 +439,32 @@ fn bom_lines(assembly: &Assembly) -> Vec<(PartKind, Color, usize)> {
     counts.into_iter().map(|((p, c), n)| (p, c, n)).collect()
 }
 
-/// Parts-list geometry: columns and rows of cells on a page.
+/// Parts-list geometry: columns of cells on a page; a cell is its part's
+/// picture over [`BOM_TEXT_H`] of text.
 const BOM_COLUMNS: usize = 4;
-const BOM_CELL_H: f32 = 46.0;
+const BOM_TEXT_H: f32 = 24.0;
+/// The picture's height in a cell, and the least it may shrink to so that
+/// the list takes a page less.
+const BOM_PICTURE_H: f32 = 22.0;
+const BOM_PICTURE_MIN_H: f32 = 15.0;
 
-fn bom_rows_per_page(template: &Template) -> usize {
+/// The parts list's rows a page and its pictures' height for `kinds`
+/// lines: full-size pictures, unless smaller ones (down to
+/// [`BOM_PICTURE_MIN_H`]) put the list on fewer pages, as when one or two
+/// parts would spill onto a page of their own.
+fn bom_grid(template: &Template, kinds: usize) -> (usize, f32) {
     let (_, h) = template.page.size.mm();
     let usable = h - 2.0 * template.page.margin - 16.0 - 8.0;
-    ((usable / BOM_CELL_H).floor() as usize).max(1)
+    let rows = |picture: f32| ((usable / (picture + BOM_TEXT_H)).floor() as usize).max(1);
+    let pages = |picture: f32| kinds.div_ceil(BOM_COLUMNS * rows(picture)).max(1);
+    let full = pages(BOM_PICTURE_H);
+    // The largest picture that takes fewer pages, in steps of a millimetre.
+    let smaller = (BOM_PICTURE_MIN_H as u32..BOM_PICTURE_H as u32)
+        .rev()
+        .map(|mm| mm as f32)
+        .find(|&p| pages(p) < full);
+    let picture = smaller.unwrap_or(BOM_PICTURE_H);
+    (rows(picture), picture)
 }
 
 fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<(Vec<u8>, usize)> {
@@ -520,7 +538,7 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<(Vec<u8>,
 
     // Bill of materials.
     let bom = bom_lines(input.assembly);
-    let rows = bom_rows_per_page(t);
+    let (rows, picture_h) = bom_grid(t, bom.len());
     let cell_w = cw / BOM_COLUMNS as f32;
     for chunk in bom.chunks(BOM_COLUMNS * rows) {
         let mut page = PageOps::new(ph);
@@ -534,15 +552,15 @@ fn booklet_bytes(input: &BookletInput<'_>, t: &Template) -> io::Result<(Vec<u8>,
         for (i, &(part, color, count)) in chunk.iter().enumerate() {
             let (col, row) = (i % BOM_COLUMNS, i / BOM_COLUMNS);
             let x = m + col as f32 * cell_w;
-            let y = head_y + 8.0 + row as f32 * BOM_CELL_H;
+            let y = head_y + 8.0 + row as f32 * (picture_h + BOM_TEXT_H);
             if let Some(pic) = pictures.get(&(part, color)) {
-                page.image(pic, x + 2.0, y, cell_w - 4.0, 22.0);
+                page.image(pic, x + 2.0, y, cell_w - 4.0, picture_h);
             }
             let spec = part.spec();
             let bl_color = color
                 .spec()
                 .map_or_else(|| "no BrickLink colour".into(), |c| c.bricklink.to_string());
-            let mut ly = y + 22.0 + ts * 0.3528 + 2.0;
+            let mut ly = y + picture_h + ts * 0.3528 + 2.0;
             page.text(
                 &fonts,
                 x + 2.0,
@@ -696,6 +714,24 @@ mod tests {
     use super::*;
     use crate::assembly::{Placement, StepGrouping};
     use crate::geom::{Cell, Rot};
+
+    #[test]
+    fn a_parts_list_a_few_kinds_over_a_page_shrinks_its_pictures_to_fit() {
+        let t = Template::default();
+        let (full_rows, full) = bom_grid(&t, 1);
+        assert_eq!(full, BOM_PICTURE_H);
+        let per_page = BOM_COLUMNS * full_rows;
+        // A page's worth keeps full-size pictures.
+        assert_eq!(bom_grid(&t, per_page), (full_rows, BOM_PICTURE_H));
+        // One or two kinds over: smaller pictures, one page.
+        for kinds in [per_page + 1, per_page + 2] {
+            let (rows, picture) = bom_grid(&t, kinds);
+            assert!((BOM_PICTURE_MIN_H..BOM_PICTURE_H).contains(&picture));
+            assert!(BOM_COLUMNS * rows >= kinds, "{kinds} kinds in {rows} rows");
+        }
+        // Whole pages' worth, as many pages either way: full-size pictures.
+        assert_eq!(bom_grid(&t, 3 * per_page).1, BOM_PICTURE_H);
+    }
 
     /// A two-course wall of 2x4s and a slope, one colour per course, and
     /// flat test pictures for it.
