@@ -395,10 +395,16 @@ impl Attempt {
     }
 
     /// The model's own pieces (not support columns) in the steps before
-    /// the first failure; all of them when none fails.
+    /// the first failure (or the first step not checked); all of them when
+    /// none fails.
     fn progress(&self) -> usize {
         let supports: std::collections::HashSet<&Placement> = self.supports.iter().collect();
-        let fails = self.check.first_failure.unwrap_or(u32::MAX);
+        // Past the budget, the steps not checked count as not standing.
+        let fails = match (self.check.first_failure, self.check.complete) {
+            (Some(step), _) => step,
+            (None, true) => u32::MAX,
+            (None, false) => self.check.steps.last().map_or(0, |s| s.step + 1),
+        };
         self.plan
             .1
             .pieces
@@ -581,9 +587,10 @@ fn support(
         let from = first_change(asm, &shored.assembly);
         let c = analyze_steps_from(&shored.assembly, params, true, Some(deadline), from)?;
         counts.add(&c);
-        if !c.complete {
-            break;
-        }
+        // Out of time part way: the columns are still kept if the steps
+        // checked stand further than before (the report then says the
+        // check is incomplete), and no round follows.
+        let out_of_time = !c.complete;
         let supports: Vec<Placement> = best
             .supports
             .iter()
@@ -610,6 +617,9 @@ fn support(
         }
         *best = candidate;
         kept.columns.extend(shored.columns);
+        if out_of_time {
+            break;
+        }
     }
     steps_of(&best.plan.1, &mut kept.columns);
     Ok(kept)
