@@ -472,6 +472,13 @@ pub(super) fn solve_propped(
         .verbose(false)
         .max_threads(1)
         .direct_solve_method("qdldl".to_string())
+        // Refining each Newton step's linear solve took a third of the
+        // time (its triangular solves and products); without it the
+        // solver still stops only at its full tolerances on the true
+        // residuals. On every step of a bunny at 32 studs: 1.4 times
+        // faster, the same verdicts, every usage within 7e-4 of the
+        // refined answer's.
+        .iterative_refinement_enable(false)
         .build()
         .map_err(|e| PhysicsError::Bug(format!("solver settings: {e}")))?;
     let mut solver = DefaultSolver::new(&pm, &lp.cost, &a, &b, &cones, settings)
