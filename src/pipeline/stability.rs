@@ -191,6 +191,7 @@ pub fn settle(
         deadline,
         &mut counts,
         tell,
+        None,
     )?;
     let before = Before {
         first_failure: first.check.first_failure,
@@ -227,7 +228,15 @@ pub fn settle(
             {
                 continue;
             }
-            let mut candidate = attempt(planned, params, true, deadline, &mut counts, None)?;
+            let mut candidate = attempt(
+                planned,
+                params,
+                true,
+                deadline,
+                &mut counts,
+                None,
+                Some(last),
+            )?;
             if candidate.better_than(&mut best, params, &mut counts)? {
                 best = candidate;
                 reseeded = Some(other);
@@ -290,7 +299,7 @@ pub fn settle(
         }
     }
     // A check that stopped at its first failure: the rest of it.
-    complete(&mut best, params, deadline, &mut counts)?;
+    check_the_rest(&mut best, params, deadline, &mut counts)?;
     let mut on_baseplate = None;
     if best.check.first_failure.is_some()
         && params.ground == Ground::Table
@@ -417,8 +426,9 @@ impl Attempt {
 /// Checks every step of `plan` and, when `repair` and only the steps
 /// before the end fail, tries the order repair on it. A check for a
 /// repair stops at the first failure, which is what the repairs work on
-/// (the rest is checked at the end, see [`complete`]); the finished model
-/// is then analysed on its own.
+/// (the rest is checked at the end, see [`check_the_rest`]); the finished
+/// model is then analysed on its own, unless its analysis is `finished`
+/// already.
 fn attempt(
     plan: Plan,
     params: &Params,
@@ -426,16 +436,19 @@ fn attempt(
     deadline: Instant,
     counts: &mut Counts,
     tell: Option<&dyn Fn(u64, u64)>,
+    finished: Option<Analysis>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
     let mut check = analyze_steps_told(&plan.1, params, repair, Some(deadline), 1, tell)?;
     counts.add(&check);
     let mut partial = stopped_early(&plan.1, &check);
-    let finished = if partial {
-        counts.solves += 1;
-        analyze(&plan.1, params)?
-    } else {
-        check.last.clone()
+    let finished = match finished {
+        Some(known) => known,
+        None if partial => {
+            counts.solves += 1;
+            analyze(&plan.1, params)?
+        }
+        None => check.last.clone(),
     };
     let stands = finished.stands();
     let mut order_fix = None;
@@ -483,7 +496,7 @@ fn stopped_early(asm: &Assembly, check: &StepsAnalysis) -> bool {
 /// Completes a check that stopped at its first failure: the steps after
 /// it, and the finished model as its `last`; past the deadline, only the
 /// finished model's analysis (known already) takes `last`'s place.
-fn complete(
+fn check_the_rest(
     best: &mut Attempt,
     params: &Params,
     deadline: Instant,
