@@ -137,6 +137,24 @@ fn run_refs(
         .collect()
 }
 
+/// [`run_refs`], leaving out (`None`) each job that would start past
+/// `deadline`.
+fn run_within(
+    s: &Structure,
+    jobs: &[&Job],
+    params: &Params,
+    deadline: Option<std::time::Instant>,
+) -> Result<Vec<Option<(Vec<PieceStress>, Found)>>, PhysicsError> {
+    jobs.par_iter()
+        .map(|job| {
+            if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                return Ok(None);
+            }
+            run_refs(s, std::slice::from_ref(job), params).map(|mut r| r.pop())
+        })
+        .collect()
+}
+
 /// Solves the jobs in parallel, in order: each job's stress per piece.
 fn run(
     s: &Structure,
@@ -333,10 +351,18 @@ pub fn analyze_steps_told(
                 .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
                 .collect();
             let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
-            let results = run_refs(&s, &batch_jobs, params)?;
-            solves += results.iter().filter(|r| r.1 == Found::Solved).count();
-            certified += results.iter().filter(|r| r.1 == Found::Certified).count();
-            solved.extend(batch.into_iter().zip(results.into_iter().map(|r| r.0)));
+            // A program that would start past the deadline is left out:
+            // its step stops the check below (a batch of big programs
+            // started just before the deadline would overrun it by
+            // minutes).
+            let results = run_within(&s, &batch_jobs, params, deadline)?;
+            for (key, r) in batch.into_iter().zip(results) {
+                if let Some((r, found)) = r {
+                    solves += usize::from(found == Found::Solved);
+                    certified += usize::from(found == Found::Certified);
+                    solved.insert(key, r);
+                }
+            }
         }
         let (step, end) = bounds[k];
         let mut late = Vec::new();
@@ -357,6 +383,10 @@ pub fn analyze_steps_told(
             } else {
                 late.push(job);
             }
+        }
+        if !late.is_empty() && deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            complete = false;
+            break;
         }
         let results = run_refs(&s, &late, params)?;
         solves += results.iter().filter(|r| r.1 == Found::Solved).count();
