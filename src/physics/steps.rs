@@ -114,12 +114,11 @@ enum Found {
     Solved,
 }
 
+/// A job's stress per piece, and how it was found.
+type Answer = (Vec<PieceStress>, Found);
+
 /// [`run`] on borrowed jobs.
-fn run_refs(
-    s: &Structure,
-    jobs: &[&Job],
-    params: &Params,
-) -> Result<Vec<(Vec<PieceStress>, Found)>, PhysicsError> {
+fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
             if !job.grounded {
@@ -144,7 +143,7 @@ fn run_within(
     jobs: &[&Job],
     params: &Params,
     deadline: Option<std::time::Instant>,
-) -> Result<Vec<Option<(Vec<PieceStress>, Found)>>, PhysicsError> {
+) -> Result<Vec<Option<Answer>>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
             if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
@@ -156,11 +155,7 @@ fn run_within(
 }
 
 /// Solves the jobs in parallel, in order: each job's stress per piece.
-fn run(
-    s: &Structure,
-    jobs: &[Job],
-    params: &Params,
-) -> Result<Vec<(Vec<PieceStress>, Found)>, PhysicsError> {
+fn run(s: &Structure, jobs: &[Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
     run_refs(s, &jobs.iter().collect::<Vec<_>>(), params)
 }
 
