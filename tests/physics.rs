@@ -219,6 +219,14 @@ fn an_overhang_falls_when_built_before_its_counterweight() {
     let right = analyze_steps(&overhang(true), &params, false).unwrap();
     assert!(right.steps.iter().all(|s| s.stands), "{right:?}");
     assert_eq!(right.first_failure, None);
+    // Only the last step needs a program (the base and the counterweight
+    // rest straight on what is below them), and the finished build is that
+    // very program: it is solved once, and reads as a solve afresh does.
+    assert_eq!(right.solves, 1, "{right:?}");
+    assert_eq!(
+        right.last.pieces,
+        analyze(&overhang(true), &params).unwrap().pieces
+    );
     // The overhang's clutch: moment 2.24 g * 9.81 * (6 - 4) about the base
     // edge on one stud at lever 0.5.
     let want = weight("3009") * 2.0 / 0.5 / CLUTCH_N;

@@ -353,7 +353,8 @@ pub struct StepsAnalysis {
     pub last: Analysis,
     /// Wall-clock seconds for everything.
     pub seconds: f64,
-    /// Programs solved (the finished build's groups count as one).
+    /// Programs solved (the finished build's groups count as one, and as
+    /// none when the last step checked had solved them all).
     pub solves: usize,
     /// Groups whose result was carried over from the step before instead:
     /// untouched, or grown only by pieces resting straight on the ground

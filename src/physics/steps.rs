@@ -154,28 +154,47 @@ fn run_within(
         .collect()
 }
 
-/// Solves the jobs in parallel, in order: each job's stress per piece.
-fn run(s: &Structure, jobs: &[Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
-    run_refs(s, &jobs.iter().collect::<Vec<_>>(), params)
-}
-
 /// Every piece of the first `n` pieces, all groups solved (in parallel).
 pub(super) fn solve_all(
     s: &Structure,
     n: usize,
     params: &Params,
 ) -> Result<Vec<PieceStress>, PhysicsError> {
+    solve_all_but(s, n, params, None).map(|(out, _)| out)
+}
+
+/// [`solve_all`], taking from `known` (stress, and whether it is exact)
+/// the answer of every group whose pieces are all exact there: a group's
+/// answer is exact when it was found for that very group (the same
+/// pieces, so the same program). Also says whether any group was run.
+fn solve_all_but(
+    s: &Structure,
+    n: usize,
+    params: &Params,
+    known: Option<(&[PieceStress], &[bool])>,
+) -> Result<(Vec<PieceStress>, bool), PhysicsError> {
     let mut g = Groups::new();
     let (mut next, mut reused) = (0, 0);
     let jobs = jobs_for_step(s, &mut g, &mut next, n, &mut reused);
-    let results = run(s, &jobs, params)?;
     let mut out = vec![PieceStress::falling(); n];
-    for (job, (r, _)) in jobs.iter().zip(results) {
+    let mut todo = Vec::with_capacity(jobs.len());
+    for job in &jobs {
+        match known {
+            Some((stress, exact)) if job.pieces.iter().all(|&p| exact[p]) => {
+                for &p in &job.pieces {
+                    out[p] = stress[p];
+                }
+            }
+            _ => todo.push(job),
+        }
+    }
+    let results = run_refs(s, &todo, params)?;
+    for (job, (r, _)) in todo.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
         }
     }
-    Ok(out)
+    Ok((out, !todo.is_empty()))
 }
 
 /// Analyses every intermediate build (the pieces of steps `1..=k`, for
@@ -190,7 +209,8 @@ pub(super) fn solve_all(
 /// clutch usage, the new pieces using none. Only the other groups are
 /// solved, in parallel (up to 16 steps ahead at once, so a check that
 /// stops at a failure may have solved a few steps past it). The finished
-/// build is solved afresh, so [`StepsAnalysis::last`] is what
+/// build's groups are solved afresh, but for those whose program the last
+/// step solved already, so [`StepsAnalysis::last`] is what
 /// [`analyze`](super::analyze) gives (and the last step's check agrees
 /// with it); with `stop_at_first_failure` and a failure, `last` is the
 /// failing step's structure instead.
@@ -266,6 +286,9 @@ pub fn analyze_steps_told(
     let mut g = Groups::new();
     let (mut next, mut reused, mut solves, mut certified) = (0, 0, 0, 0);
     let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
+    // Whether each piece's entry in `current` is exact: found for the
+    // group it is in now (see `solve_all_but`).
+    let mut exact = vec![false; assembly.pieces.len()];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
     // Every step's groups, and whether each needs a solve if everything
@@ -324,6 +347,7 @@ pub fn analyze_steps_told(
             let whole = solve_all(&s, end, params)?;
             solves += 1;
             current[..end].copy_from_slice(&whole);
+            exact[..end].fill(true);
             steps.push(check(step, &current[..end]));
             begin = end;
             if !steps[steps.len() - 1].stands {
@@ -369,10 +393,15 @@ pub fn analyze_steps_told(
             if let Some(r) = solved.remove(&(k, j)) {
                 for (&p, st) in job.pieces.iter().zip(r) {
                     current[p] = st;
+                    exact[p] = true;
                 }
             } else if job.grounded && stood && drops(&s, job, begin, end) {
                 for &p in job.pieces.iter().filter(|&&p| p >= begin) {
                     current[p] = PieceStress::resting();
+                }
+                // It stands, but its answer need not be the program's.
+                for &p in &job.pieces {
+                    exact[p] = false;
                 }
                 reused += 1;
             } else {
@@ -389,6 +418,7 @@ pub fn analyze_steps_told(
         for (job, (r, _)) in late.iter().zip(results) {
             for (&p, st) in job.pieces.iter().zip(r) {
                 current[p] = st;
+                exact[p] = true;
             }
         }
         steps.push(check(step, &current[..end]));
@@ -407,8 +437,11 @@ pub fn analyze_steps_told(
     } else {
         assembly.pieces.len()
     };
-    let last = solve_all(&s, end, params)?;
-    solves += 1;
+    // A complete check has found the last step's groups already, most of
+    // them exactly: only the others are solved again.
+    let known = complete.then_some((&current[..end], &exact[..end]));
+    let (last, ran) = solve_all_but(&s, end, params, known)?;
+    solves += usize::from(ran);
     if !complete && first_failure.is_none() && last.iter().any(PieceStress::fails) {
         // Unchecked steps in between: the finished build is known to fail.
         first_failure = assembly.pieces.last().map(|p| p.step.0);
