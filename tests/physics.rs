@@ -223,6 +223,9 @@ fn an_overhang_falls_when_built_before_its_counterweight() {
     // rest straight on what is below them), and the finished build is that
     // very program: it is solved once, and reads as a solve afresh does.
     assert_eq!(right.solves, 1, "{right:?}");
+    // Its time is that program's, carried over with its answer.
+    assert!(right.last.solve_seconds > 0.0, "{right:?}");
+    assert!(right.last.solve_seconds <= right.seconds, "{right:?}");
     assert_eq!(
         right.last.pieces,
         analyze(&overhang(true), &params).unwrap().pieces

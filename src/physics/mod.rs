@@ -349,7 +349,9 @@ pub struct StepsAnalysis {
     pub steps: Vec<StepCheck>,
     /// The first step at which something falls or breaks off.
     pub first_failure: Option<u32>,
-    /// The finished build's analysis (of the last step checked).
+    /// The finished build's analysis (of the last step checked). Its
+    /// `solve_seconds` are its programs' (the biggest of them, when the
+    /// last step's answers are carried over), not the whole check's.
     pub last: Analysis,
     /// Wall-clock seconds for everything.
     pub seconds: f64,

@@ -145,8 +145,10 @@ pub struct Shored {
 
 /// Adds support columns until the structure built by the end of step
 /// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
-/// (counting `already`) are in, or the deadline passes. Columns are made
-/// of pieces in `color`. `None` when no column could be added.
+/// (counting `already`) are in, or the deadline passes (a round that
+/// would end past it, taking as long as the round before, does not
+/// start). Columns are made of pieces in `color`. `None` when no column
+/// could be added.
 pub fn shore_up(
     assembly: &Assembly,
     params: &Params,
@@ -163,8 +165,12 @@ pub fn shore_up(
     let mut stands = false;
     let mut excluded: HashSet<Footprint> = HashSet::new();
     // The last round only checks the columns the one before added.
+    // A round that would not end by the deadline (taking as long as the
+    // one before) does not start.
+    let mut last_round = std::time::Duration::ZERO;
     for round in 0..=ROUNDS {
-        if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+        let begun = std::time::Instant::now();
+        if deadline.is_some_and(|d| begun + last_round >= d) {
             break;
         }
         let end = match upto {
@@ -211,6 +217,7 @@ pub fn shore_up(
         asm = next;
         columns.extend(added);
         pieces.extend(placed);
+        last_round = begun.elapsed();
     }
     if columns.is_empty() {
         return Ok(None);

@@ -210,8 +210,16 @@ pub fn settle(
         // Other layouts of the same voxels; the first that stands at every
         // step (after its own order repair) is kept, else the best tried.
         let mut tried = 0;
+        // Another layout is worth its search only if its finished model
+        // can be analysed by the deadline (about as long as this one's).
+        let analysis = Duration::from_secs_f64(
+            best.finished
+                .as_ref()
+                .map_or(0.0, |f| f.solve_seconds)
+                .min(1e9),
+        );
         for k in 1..=RESEEDS {
-            if Instant::now() >= deadline {
+            if Instant::now() + analysis >= deadline {
                 break;
             }
             tried += 1;
@@ -562,7 +570,16 @@ fn support(
         columns: Vec::new(),
         color: Some(color),
     };
-    while Instant::now() < deadline && kept.columns.len() < MAX_COLUMNS {
+    // A round analyses the model at least twice (before and with its
+    // columns): one that cannot end by the deadline does not start.
+    let round = Duration::from_secs_f64(
+        2.0 * best
+            .finished
+            .as_ref()
+            .map_or(0.0, |f| f.solve_seconds)
+            .min(1e9),
+    );
+    while Instant::now() + round < deadline && kept.columns.len() < MAX_COLUMNS {
         let Some(target) = best.check.first_failure else {
             break;
         };
