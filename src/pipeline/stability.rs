@@ -212,12 +212,7 @@ pub fn settle(
         let mut tried = 0;
         // Another layout is worth its search only if its finished model
         // can be analysed by the deadline (about as long as this one's).
-        let analysis = Duration::from_secs_f64(
-            best.finished
-                .as_ref()
-                .map_or(0.0, |f| f.solve_seconds)
-                .min(1e9),
-        );
+        let analysis = best.analysis_time();
         for k in 1..=RESEEDS {
             if Instant::now() + analysis >= deadline {
                 break;
@@ -379,6 +374,13 @@ struct Attempt {
 }
 
 impl Attempt {
+    /// How long the finished model's analysis took (zero when not made).
+    fn analysis_time(&self) -> Duration {
+        // Capped at about 31 years, so that adding it to a time is safe.
+        let secs = self.finished.as_ref().map_or(0.0, |f| f.solve_seconds);
+        Duration::from_secs_f64(secs.clamp(0.0, 1e9))
+    }
+
     /// Stands at more steps: the finished model first, then more of the
     /// model's own pieces built before the first failure (counted in
     /// pieces, not steps: support columns add steps), then a higher lowest
@@ -572,13 +574,7 @@ fn support(
     };
     // A round analyses the model at least twice (before and with its
     // columns): one that cannot end by the deadline does not start.
-    let round = Duration::from_secs_f64(
-        2.0 * best
-            .finished
-            .as_ref()
-            .map_or(0.0, |f| f.solve_seconds)
-            .min(1e9),
-    );
+    let round = 2 * best.analysis_time();
     while Instant::now() + round < deadline && kept.columns.len() < MAX_COLUMNS {
         let Some(target) = best.check.first_failure else {
             break;
