@@ -161,7 +161,8 @@ fn past(deadline: Option<Instant>) -> bool {
     deadline.is_some_and(|d| Instant::now() >= d)
 }
 
-/// [`run`] on borrowed jobs.
+/// Solves the jobs in parallel, in order: each job's stress per piece,
+/// how it was found and the seconds its solve took.
 fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
