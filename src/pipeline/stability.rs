@@ -959,37 +959,3 @@ pub(super) fn stage(
         stability: Some((report, finished)),
     })
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::catalog::PartKind;
-    use crate::geom::{Cell, Rot};
-
-    #[test]
-    fn an_analysis_follows_its_pieces_into_another_order() {
-        let brick = PartKind::from_id("3001").expect("a 2 x 4 brick");
-        let at = |x, z| Placement::new(brick, Cell::new(x, 0, z), Rot::R0);
-        // A base, a brick hanging three studs past it, and one on the base.
-        let order = [at(0, 0), at(3, 1), at(0, 1)];
-        let before = Assembly::from_order(&order, 24, Color::RED);
-        let after = Assembly::from_order(&[order[0], order[2], order[1]], 24, Color::RED);
-        let a = analyze(&before, &Params::default()).unwrap();
-        assert_ne!(a.pieces[1], a.pieces[2], "{a:?}");
-        let b = reindexed(&a, &before, &after).unwrap();
-        assert_eq!(b.pieces, [a.pieces[0], a.pieces[2], a.pieces[1]]);
-        // What the new order's own analysis says (its program lists the
-        // same forces in another order: the same answer but for round-off).
-        let fresh = analyze(&after, &Params::default()).unwrap();
-        for (p, q) in b.pieces.iter().zip(&fresh.pieces) {
-            assert!((p.usage - q.usage).abs() < 1e-9, "{p:?} {q:?}");
-            assert_eq!((p.falls, p.breaks), (q.falls, q.breaks));
-        }
-        assert_eq!(b.min_score, a.min_score);
-        // Not the same pieces: no answer.
-        let fewer = Assembly::from_order(&order[..2], 24, Color::RED);
-        assert!(reindexed(&a, &before, &fewer).is_none());
-        let moved = Assembly::from_order(&[order[0], order[1], at(1, 1)], 24, Color::RED);
-        assert!(reindexed(&a, &before, &moved).is_none());
-    }
-}
