@@ -9,8 +9,8 @@ use brickwright::assembly::{Assembly, Placed, Placement, Step, StepGrouping};
 use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
 use brickwright::physics::{
-    analyze, analyze_steps, analyze_steps_from, analyze_steps_told, Ground, Params, CLUTCH_N,
-    GRAVITY,
+    analyze, analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_with_finished,
+    Ground, Params, CLUTCH_N, GRAVITY,
 };
 
 use Rot::{R0, R90};
@@ -235,6 +235,67 @@ fn an_overhang_falls_when_built_before_its_counterweight() {
     let want = weight("3009") * 2.0 / 0.5 / CLUTCH_N;
     let got = right.last.pieces[2].usage;
     assert!(close(got, want, 0.01), "{got} vs {want}");
+}
+
+/// The finished model analysed alongside the steps (as the repairs ask
+/// for it): the same steps and `last` as a check without it, nothing
+/// solved twice, and `finished` is what `analyze` gives, even when the
+/// check stops at a failure before the end.
+#[test]
+fn the_finished_model_is_analysed_alongside_the_steps() {
+    let params = Params::default();
+    for (name, asm) in [
+        ("stands", overhang(true)),
+        ("fails at step 2", overhang(false)),
+        ("mug", fixture_build("mug.obj", 16)),
+    ] {
+        let whole = analyze(&asm, &params).unwrap();
+        for stop in [true, false] {
+            let plain = analyze_steps(&asm, &params, stop).unwrap();
+            let both =
+                analyze_steps_with_finished(&asm, &params, stop, None, 1, None, None).unwrap();
+            assert!(plain.finished.is_none(), "{name}");
+            assert_eq!(both.steps, plain.steps, "{name}");
+            assert_eq!(both.first_failure, plain.first_failure, "{name}");
+            assert_eq!(both.last.pieces, plain.last.pieces, "{name}");
+            let finished = both.finished.as_ref().expect("made alongside");
+            assert_eq!(finished.pieces, whole.pieces, "{name}");
+            assert!(finished.solve_seconds > 0.0, "{name}");
+            // The last step takes the finished model's answers instead of
+            // solving them again; only a check stopped before the end
+            // solves the finished model on top.
+            let stopped = stop && plain.first_failure.is_some_and(|f| f < asm.step_count());
+            assert!(
+                both.solves <= plain.solves + usize::from(stopped),
+                "{name}: {} against {}",
+                both.solves,
+                plain.solves
+            );
+            // Given the finished model's analysis, the check reads the
+            // same and solves one program fewer.
+            let given =
+                analyze_steps_with_finished(&asm, &params, stop, None, 1, None, Some(&whole))
+                    .unwrap();
+            assert_eq!(given.steps, both.steps, "{name}");
+            assert_eq!(given.last.pieces, both.last.pieces, "{name}");
+            assert_eq!(given.finished.as_ref(), Some(&whole), "{name}");
+            assert_eq!(given.solves + 1, both.solves, "{name}");
+        }
+    }
+    // An analysis of another assembly is refused.
+    let other = analyze(&overhang(true), &params).unwrap();
+    let small = build(&[("3001", 0, 0, 0, R0, 1)]);
+    assert!(
+        analyze_steps_with_finished(&small, &params, true, None, 1, None, Some(&other)).is_err()
+    );
+    // Built before its counterweight, the overhang tips at step 2: the
+    // check stops there, and the finished model (which stands) is still
+    // analysed.
+    let wrong =
+        analyze_steps_with_finished(&overhang(false), &params, true, None, 1, None, None).unwrap();
+    assert_eq!(wrong.first_failure, Some(2));
+    assert!(!wrong.last.stands());
+    assert!(wrong.finished.unwrap().stands());
 }
 
 #[test]

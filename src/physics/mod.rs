@@ -133,7 +133,10 @@ use crate::catalog::PartSpec;
 
 use crate::assembly::Assembly;
 
-pub use steps::{analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_within};
+pub use steps::{
+    analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_with_finished,
+    analyze_steps_within,
+};
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
 /// for where it comes from).
@@ -370,6 +373,11 @@ pub struct StepsAnalysis {
     /// there) was checked; false when the deadline of
     /// [`analyze_steps_within`] cut the check short.
     pub complete: bool,
+    /// The finished model's analysis, when it was asked for alongside the
+    /// steps ([`analyze_steps_with_finished`]): `last` too, unless the
+    /// check stopped at a failure before the end.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finished: Option<Analysis>,
 }
 
 /// Why an analysis failed.

@@ -144,16 +144,32 @@ impl Reserve {
         }
     }
 
-    /// `deadline`, less the time kept.
-    fn cut(&self, deadline: Option<Instant>, start: Instant) -> Option<Instant> {
+    /// `deadline`, less the time kept: for an analysis that runs `After`
+    /// the check, all of it; for one running `Alongside` since `start`,
+    /// what is left of it; for one `Done`, nothing.
+    fn cut(&self, deadline: Option<Instant>, start: Instant, when: Finishing) -> Option<Instant> {
         let (n, secs) = match self.biggest {
-            Some((n, secs)) if 4 * n >= self.total => (n, secs),
+            Some((n, secs)) if 4 * n >= self.total && when != Finishing::Done => (n, secs),
             _ => return deadline,
         };
-        let keep = secs * (self.total as f64 / n as f64).powf(GROWTH);
+        let mut keep = secs * (self.total as f64 / n as f64).powf(GROWTH);
+        if when == Finishing::Alongside {
+            keep = (keep - start.elapsed().as_secs_f64()).max(0.0);
+        }
         let keep = Duration::try_from_secs_f64(keep).unwrap_or(Duration::MAX);
         deadline.map(|d| d.checked_sub(keep).unwrap_or(start).max(start))
     }
+}
+
+/// When the finished model's analysis is made, for [`Reserve::cut`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Finishing {
+    /// After the step check.
+    After,
+    /// Alongside it, and not done yet.
+    Alongside,
+    /// Alongside it, and done.
+    Done,
 }
 
 /// Whether `deadline` has passed.
@@ -326,9 +342,127 @@ pub fn analyze_steps_told(
     from: u32,
     tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    check_steps(
+        assembly,
+        params,
+        stop_at_first_failure,
+        deadline,
+        from,
+        tell,
+        None,
+    )
+}
+
+/// [`analyze_steps_told`], with the finished model's analysis as well
+/// ([`StepsAnalysis::finished`]), even when the check stops at a failure
+/// before the end: for a caller that needs both, as the repairs do.
+/// `known` is that analysis when the caller has it already (of this very
+/// assembly, pieces in this order: what [`analyze`](super::analyze) gave).
+///
+/// Otherwise the finished model's programs are solved from the start,
+/// alongside the steps' (so that no core waits while the biggest program
+/// runs alone at the end). Either way the last step takes their answers,
+/// and a check cut short by the deadline does not solve the finished
+/// model again: nothing is solved twice, and the step check keeps for the
+/// finished model's analysis only what is left of it (estimated as for
+/// [`analyze_steps_within`]).
+pub fn analyze_steps_with_finished(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<Instant>,
+    from: u32,
+    tell: Option<&dyn Fn(u64, u64)>,
+    known: Option<&Analysis>,
+) -> Result<StepsAnalysis, PhysicsError> {
+    if known.is_some_and(|a| a.pieces.len() != assembly.pieces.len()) {
+        return Err(PhysicsError::Bug(
+            "the finished model's analysis given is of another assembly".into(),
+        ));
+    }
+    check_steps(
+        assembly,
+        params,
+        stop_at_first_failure,
+        deadline,
+        from,
+        tell,
+        Some(known),
+    )
+}
+
+/// The finished model's groups, solved: each piece's stress and the
+/// seconds it took.
+type Finished = (Vec<PieceStress>, f64);
+
+/// Waits for the finished model's analysis started alongside the steps.
+fn joined(
+    handle: std::thread::ScopedJoinHandle<'_, Result<Finished, PhysicsError>>,
+) -> Result<Finished, PhysicsError> {
+    handle
+        .join()
+        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+}
+
+/// [`analyze_steps_told`], and with `finish` (the finished model's
+/// analysis if known) [`analyze_steps_with_finished`].
+fn check_steps(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<Instant>,
+    from: u32,
+    tell: Option<&dyn Fn(u64, u64)>,
+    finish: Option<Option<&Analysis>>,
+) -> Result<StepsAnalysis, PhysicsError> {
     let start = Instant::now();
     params.check()?;
     let s = Structure::new(assembly, params);
+    let n = assembly.pieces.len();
+    std::thread::scope(|scope| {
+        // The finished model, on a thread of its own (its programs go to
+        // the same pool as the steps').
+        let background = matches!(finish, Some(None)).then(|| {
+            let s = &s;
+            scope.spawn(move || {
+                let begun = Instant::now();
+                solve_all(s, n, params).map(|r| (r, begun.elapsed().as_secs_f64()))
+            })
+        });
+        check_steps_in(
+            assembly,
+            params,
+            &s,
+            stop_at_first_failure,
+            deadline,
+            from,
+            tell,
+            start,
+            background,
+            finish
+                .flatten()
+                .map(|a| (a.pieces.clone(), a.solve_seconds)),
+        )
+    })
+}
+
+/// [`check_steps`] once the structure is built, with the finished model's
+/// analysis running in `background`, or `finished` already, when asked
+/// for.
+#[allow(clippy::too_many_arguments)]
+fn check_steps_in(
+    assembly: &Assembly,
+    params: &Params,
+    s: &Structure,
+    stop_at_first_failure: bool,
+    deadline: Option<Instant>,
+    from: u32,
+    tell: Option<&dyn Fn(u64, u64)>,
+    start: Instant,
+    mut background: Option<std::thread::ScopedJoinHandle<'_, Result<Finished, PhysicsError>>>,
+    mut finished: Option<Finished>,
+) -> Result<StepsAnalysis, PhysicsError> {
+    let n = assembly.pieces.len();
     // (step number, end of its pieces in build order).
     let mut bounds: Vec<(u32, usize)> = Vec::new();
     for (i, p) in assembly.pieces.iter().enumerate() {
@@ -357,7 +491,7 @@ pub fn analyze_steps_told(
     let mut all_jobs: Vec<Vec<Job>> = Vec::with_capacity(bounds.len());
     for (k, &(_, end)) in bounds.iter().enumerate() {
         let before = reused;
-        all_jobs.push(jobs_for_step(&s, &mut g, &mut next, end, &mut reused));
+        all_jobs.push(jobs_for_step(s, &mut g, &mut next, end, &mut reused));
         if k0 > 0 && k <= k0 {
             // Skipped, or solved whole: nothing of it is reused.
             reused = before;
@@ -373,7 +507,10 @@ pub fn analyze_steps_told(
             continue;
         }
         for (j, job) in jobs.iter().enumerate() {
-            if !(job.grounded && drops(&s, job, begin, end)) {
+            // The last step's groups are the finished model's: with the
+            // finished model solved alongside, they take its answers.
+            let finishing = (background.is_some() || finished.is_some()) && k + 1 == bounds.len();
+            if !(finishing || job.grounded && drops(s, job, begin, end)) {
                 ahead.push((k, j));
             }
         }
@@ -399,13 +536,13 @@ pub fn analyze_steps_told(
             continue;
         }
         if k == k0 && k0 > 0 {
-            if past(reserve.cut(deadline, start)) {
+            if past(reserve.cut(deadline, start, finishing(&background, &finished))) {
                 complete = false;
                 break;
             }
             let (step, end) = bounds[k];
             let begun = Instant::now();
-            let whole = solve_all(&s, end, params)?;
+            let whole = solve_all(s, end, params)?;
             step_seconds = begun.elapsed().as_secs_f64();
             reserve.note(end, Found::Solved, step_seconds);
             solves += 1;
@@ -424,7 +561,7 @@ pub fn analyze_steps_told(
         if k >= first_batch && (k - first_batch) % STEPS_A_BATCH == 0 {
             // Time is kept for the finished model's analysis that follows
             // a check cut short, so that the two end near the deadline.
-            let cut = reserve.cut(deadline, start);
+            let cut = reserve.cut(deadline, start, finishing(&background, &finished));
             if past(cut) {
                 complete = false;
                 break;
@@ -440,7 +577,7 @@ pub fn analyze_steps_told(
             // its step stops the check below (a batch of big programs
             // started just before the deadline would overrun it by
             // minutes).
-            let results = run_within(&s, &batch_jobs, params, cut)?;
+            let results = run_within(s, &batch_jobs, params, cut)?;
             for ((key, r), job) in batch.into_iter().zip(results).zip(&batch_jobs) {
                 if let Some((r, found, secs)) = r {
                     reserve.note(job.pieces.len(), found, secs);
@@ -464,7 +601,7 @@ pub fn analyze_steps_told(
                     current[p] = st;
                     exact[p] = true;
                 }
-            } else if job.grounded && stood && drops(&s, job, begin, end) {
+            } else if job.grounded && stood && drops(s, job, begin, end) {
                 for &p in job.pieces.iter().filter(|&&p| p >= begin) {
                     current[p] = PieceStress::resting();
                 }
@@ -477,11 +614,28 @@ pub fn analyze_steps_told(
                 late.push(job);
             }
         }
-        if !late.is_empty() && past(reserve.cut(deadline, start)) {
+        if k + 1 == bounds.len() && !late.is_empty() {
+            if let Some(handle) = background.take() {
+                finished = Some(joined(handle)?);
+                solves += 1;
+            }
+            if let Some((whole, secs)) = &finished {
+                // The finished model's groups: its answers, exact.
+                step_seconds = *secs;
+                for job in late.drain(..) {
+                    for &p in &job.pieces {
+                        current[p] = whole[p];
+                        exact[p] = true;
+                    }
+                }
+            }
+        }
+        if !late.is_empty() && past(reserve.cut(deadline, start, finishing(&background, &finished)))
+        {
             complete = false;
             break;
         }
-        let results = run_refs(&s, &late, params)?;
+        let results = run_refs(s, &late, params)?;
         solves += results.iter().filter(|r| r.1 == Found::Solved).count();
         certified += results.iter().filter(|r| r.1 == Found::Certified).count();
         for (job, (r, found, secs)) in late.iter().zip(results) {
@@ -510,17 +664,27 @@ pub fn analyze_steps_told(
     };
     // A complete check has found the last step's groups already, most of
     // them exactly: only the others are solved again.
-    let known = complete.then_some((&current[..end], &exact[..end]));
-    let begun = Instant::now();
-    let (last, ran) = solve_all_but(&s, end, params, known)?;
-    // What the finished build's programs take: as solved now, or as the
-    // last step checked solved them.
-    let last_seconds = if ran {
-        begun.elapsed().as_secs_f64()
-    } else {
-        step_seconds
+    if let Some(handle) = background.take() {
+        finished = Some(joined(handle)?);
+        solves += 1;
+    }
+    let (last, last_seconds) = match &finished {
+        Some((whole, secs)) if end == n => (whole.clone(), *secs),
+        _ => {
+            let known = complete.then_some((&current[..end], &exact[..end]));
+            let begun = Instant::now();
+            let (last, ran) = solve_all_but(s, end, params, known)?;
+            solves += usize::from(ran);
+            // What the finished build's programs take: as solved now, or
+            // as the last step checked solved them.
+            let secs = if ran {
+                begun.elapsed().as_secs_f64()
+            } else {
+                step_seconds
+            };
+            (last, secs)
+        }
     };
-    solves += usize::from(ran);
     if !complete && first_failure.is_none() && last.iter().any(PieceStress::fails) {
         // Unchecked steps in between: the finished build is known to fail.
         first_failure = assembly.pieces.last().map(|p| p.step.0);
@@ -540,7 +704,22 @@ pub fn analyze_steps_told(
         reused,
         certified,
         complete,
+        finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
     })
+}
+
+/// When the finished model's analysis is made: alongside the steps in
+/// `background` (into `finished` once joined), or after them.
+fn finishing<T>(
+    background: &Option<std::thread::ScopedJoinHandle<'_, T>>,
+    finished: &Option<Finished>,
+) -> Finishing {
+    match background {
+        Some(h) if !h.is_finished() => Finishing::Alongside,
+        Some(_) => Finishing::Done,
+        None if finished.is_some() => Finishing::Done,
+        None => Finishing::After,
+    }
 }
 
 /// The check of one intermediate build from its pieces' stress.
@@ -568,21 +747,31 @@ mod tests {
         };
         // Nothing solved yet, or only programs too small to tell: the
         // deadline as it is.
-        assert_eq!(r.cut(deadline, start), deadline);
+        assert_eq!(r.cut(deadline, start, Finishing::After), deadline);
         r.note(200, Found::Solved, 0.5);
-        assert_eq!(r.cut(deadline, start), deadline);
+        assert_eq!(r.cut(deadline, start, Finishing::After), deadline);
         // Neither answers found without a solve nor smaller programs count.
         r.note(900, Found::Certified, 0.0);
         r.note(500, Found::Solved, 2.0);
         r.note(400, Found::Solved, 9.0);
         assert_eq!(r.biggest, Some((500, 2.0)));
         // Twice the pieces: 2 s * 2^2.3 = 9.85 s kept.
-        let cut = r.cut(deadline, start).unwrap();
+        let cut = r.cut(deadline, start, Finishing::After).unwrap();
         let kept = (end - cut).as_secs_f64();
         assert!((kept - 2.0 * 2f64.powf(GROWTH)).abs() < 1e-6, "{kept}");
+        // Made alongside the check, started 5 s ago: what is left of it is
+        // kept; once done, nothing.
+        let earlier = start.checked_sub(Duration::from_secs(5)).unwrap();
+        let cut = r.cut(deadline, earlier, Finishing::Alongside).unwrap();
+        let kept = (end - cut).as_secs_f64();
+        assert!(
+            (kept - (2.0 * 2f64.powf(GROWTH) - 5.0)).abs() < 0.5,
+            "{kept}"
+        );
+        assert_eq!(r.cut(deadline, earlier, Finishing::Done), deadline);
         // More than the time there is: the check stops at once.
         r.note(600, Found::Solved, 500.0);
-        assert_eq!(r.cut(deadline, start), Some(start));
-        assert_eq!(r.cut(None, start), None);
+        assert_eq!(r.cut(deadline, start, Finishing::After), Some(start));
+        assert_eq!(r.cut(None, start, Finishing::After), None);
     }
 }

@@ -29,8 +29,8 @@ use crate::catalog::Color;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
-    analyze, analyze_steps_from, analyze_steps_told, analyze_steps_within, Analysis, Ground,
-    Params, PhysicsError, StepsAnalysis,
+    analyze, analyze_steps_from, analyze_steps_with_finished, analyze_steps_within, Analysis,
+    Ground, Params, PhysicsError, StepsAnalysis,
 };
 use crate::search::SearchOutcome;
 
@@ -437,8 +437,8 @@ impl Attempt {
 /// before the end fail, tries the order repair on it. A check for a
 /// repair stops at the first failure, which is what the repairs work on
 /// (the rest is checked at the end, see [`check_the_rest`]); the finished
-/// model is then analysed on its own, unless its analysis is `finished`
-/// already.
+/// model is analysed alongside the steps, unless its analysis is
+/// `finished` already.
 fn attempt(
     plan: Plan,
     params: &Params,
@@ -449,16 +449,24 @@ fn attempt(
     finished: Option<Analysis>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
-    let mut check = analyze_steps_told(&plan.1, params, repair, Some(deadline), 1, tell)?;
+    // The finished model is analysed alongside the steps, unless known.
+    let mut check = analyze_steps_with_finished(
+        &plan.1,
+        params,
+        repair,
+        Some(deadline),
+        1,
+        tell,
+        finished.as_ref(),
+    )?;
     counts.add(&check);
     let mut partial = stopped_early(&plan.1, &check);
-    let finished = match finished {
-        Some(known) => known,
-        None if partial => {
+    let mut finished = match (finished, check.finished.take()) {
+        (Some(known), _) | (None, Some(known)) => known,
+        (None, None) => {
             counts.solves += 1;
             analyze(&plan.1, params)?
         }
-        None => check.last.clone(),
     };
     let stands = finished.stands();
     let mut order_fix = None;
@@ -478,6 +486,10 @@ fn attempt(
                 counts.add(&c);
                 if c.complete && later(c.first_failure, check.first_failure) {
                     order_fix = Some(r.moved);
+                    // The same pieces in another order: the finished
+                    // model's analysis follows it.
+                    finished = reindexed(&finished, &plan.1, &r.assembly)
+                        .ok_or_else(|| PhysicsError::Bug("the order repair lost a piece".into()))?;
                     plan.1 = r.assembly;
                     partial = stopped_early(&plan.1, &c);
                     check = c;
@@ -493,6 +505,29 @@ fn attempt(
         order_fix,
         order_tried,
         supports: Vec::new(),
+    })
+}
+
+/// `a`, an analysis of the pieces of `before`, in the order of `after`
+/// (the same pieces, reordered); `None` when they are not the same.
+fn reindexed(a: &Analysis, before: &Assembly, after: &Assembly) -> Option<Analysis> {
+    let at: std::collections::HashMap<&Placement, usize> = before
+        .pieces
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (&p.placement, i))
+        .collect();
+    if after.pieces.len() != before.pieces.len() || a.pieces.len() != before.pieces.len() {
+        return None;
+    }
+    let pieces = after
+        .pieces
+        .iter()
+        .map(|p| at.get(&p.placement).map(|&i| a.pieces[i]))
+        .collect::<Option<Vec<_>>>()?;
+    Some(Analysis {
+        pieces,
+        ..a.clone()
     })
 }
 
@@ -519,8 +554,21 @@ fn check_the_rest(
         return Ok(());
     };
     if Instant::now() < deadline {
-        let c = analyze_steps_from(&best.plan.1, params, false, Some(deadline), from)?;
+        // The finished model's analysis, known or made alongside: a check
+        // cut short by the deadline does not make it again.
+        let mut c = analyze_steps_with_finished(
+            &best.plan.1,
+            params,
+            false,
+            Some(deadline),
+            from,
+            None,
+            best.finished.as_ref(),
+        )?;
         counts.add(&c);
+        if best.finished.is_none() {
+            best.finished = c.finished.take();
+        }
         if c.first_failure.is_some() {
             best.check = spliced(&best.check, from, c);
             best.partial = false;
@@ -910,4 +958,38 @@ pub(super) fn stage(
         order,
         stability: Some((report, finished)),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalog::PartKind;
+    use crate::geom::{Cell, Rot};
+
+    #[test]
+    fn an_analysis_follows_its_pieces_into_another_order() {
+        let brick = PartKind::from_id("3001").expect("a 2 x 4 brick");
+        let at = |x, z| Placement::new(brick, Cell::new(x, 0, z), Rot::R0);
+        // A base, a brick hanging three studs past it, and one on the base.
+        let order = [at(0, 0), at(3, 1), at(0, 1)];
+        let before = Assembly::from_order(&order, 24, Color::RED);
+        let after = Assembly::from_order(&[order[0], order[2], order[1]], 24, Color::RED);
+        let a = analyze(&before, &Params::default()).unwrap();
+        assert_ne!(a.pieces[1], a.pieces[2], "{a:?}");
+        let b = reindexed(&a, &before, &after).unwrap();
+        assert_eq!(b.pieces, [a.pieces[0], a.pieces[2], a.pieces[1]]);
+        // What the new order's own analysis says (its program lists the
+        // same forces in another order: the same answer but for round-off).
+        let fresh = analyze(&after, &Params::default()).unwrap();
+        for (p, q) in b.pieces.iter().zip(&fresh.pieces) {
+            assert!((p.usage - q.usage).abs() < 1e-9, "{p:?} {q:?}");
+            assert_eq!((p.falls, p.breaks), (q.falls, q.breaks));
+        }
+        assert_eq!(b.min_score, a.min_score);
+        // Not the same pieces: no answer.
+        let fewer = Assembly::from_order(&order[..2], 24, Color::RED);
+        assert!(reindexed(&a, &before, &fewer).is_none());
+        let moved = Assembly::from_order(&[order[0], order[1], at(1, 1)], 24, Color::RED);
+        assert!(reindexed(&a, &before, &moved).is_none());
+    }
 }
