@@ -10,7 +10,7 @@ use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
 use brickwright::physics::{
     analyze, analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_with_finished,
-    Ground, Params, CLUTCH_N, GRAVITY,
+    analyze_steps_within, Ground, Params, CLUTCH_N, GRAVITY,
 };
 
 use Rot::{R0, R90};
@@ -296,6 +296,46 @@ fn the_finished_model_is_analysed_alongside_the_steps() {
     assert_eq!(wrong.first_failure, Some(2));
     assert!(!wrong.last.stands());
     assert!(wrong.finished.unwrap().stands());
+}
+
+/// A check with a deadline starts the finished model's analysis alongside
+/// the steps once it is due (the deadline less the time it takes) instead
+/// of stopping for it: past the deadline at once, it is made, once, and
+/// is both `last` and `finished`; part way, the steps checked read as in
+/// a check without a deadline, and so does the finished model.
+#[test]
+fn a_check_cut_short_makes_the_finished_model_alongside_the_steps() {
+    let params = Params::default();
+    let asm = fixture_build("mug.obj", 16);
+    let whole = analyze(&asm, &params).unwrap();
+    // No deadline: the analysis is never due, the last step is checked.
+    let all = analyze_steps_within(&asm, &params, false, None).unwrap();
+    assert!(all.complete);
+    assert!(all.finished.is_none());
+    assert_eq!(all.last.pieces, whole.pieces);
+    // Past the deadline from the start: no step, the finished model only.
+    let none = analyze_steps_within(&asm, &params, false, Some(std::time::Instant::now())).unwrap();
+    assert!(!none.complete);
+    assert!(none.steps.is_empty());
+    assert_eq!(none.solves, 1);
+    assert_eq!(none.last.pieces, whole.pieces);
+    let finished = none.finished.as_ref().expect("made once due");
+    assert_eq!(finished.pieces, whole.pieces);
+    assert!(finished.solve_seconds > 0.0);
+    // Part way (where depends on the machine's speed): a prefix of the
+    // steps, the same.
+    for share in [0.25, 0.5] {
+        let deadline =
+            std::time::Instant::now() + std::time::Duration::from_secs_f64(all.seconds * share);
+        let part = analyze_steps_within(&asm, &params, false, Some(deadline)).unwrap();
+        assert_eq!(part.steps, all.steps[..part.steps.len()]);
+        if !part.complete {
+            assert_eq!(part.last.pieces, whole.pieces);
+        }
+        if let Some(f) = &part.finished {
+            assert_eq!(f.pieces, whole.pieces);
+        }
+    }
 }
 
 #[test]

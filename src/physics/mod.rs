@@ -374,7 +374,8 @@ pub struct StepsAnalysis {
     /// [`analyze_steps_within`] cut the check short.
     pub complete: bool,
     /// The finished model's analysis, when it was asked for alongside the
-    /// steps ([`analyze_steps_with_finished`]): `last` too, unless the
+    /// steps ([`analyze_steps_with_finished`]) or made alongside them near
+    /// the deadline ([`analyze_steps_within`]): `last` too, unless the
     /// check stopped at a failure before the end.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub finished: Option<Analysis>,

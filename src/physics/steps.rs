@@ -1,6 +1,7 @@
 //! Groups of touching pieces, kept as pieces are added step by step, and
 //! the parallel solving of the groups that grew.
 
+use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -146,10 +147,10 @@ impl Reserve {
 
     /// `deadline`, less the time kept: for an analysis that runs `After`
     /// the check, all of it; for one running `Alongside` since `start`,
-    /// what is left of it; for one `Done`, nothing.
+    /// what is left of it.
     fn cut(&self, deadline: Option<Instant>, start: Instant, when: Finishing) -> Option<Instant> {
         let (n, secs) = match self.biggest {
-            Some((n, secs)) if 4 * n >= self.total && when != Finishing::Done => (n, secs),
+            Some((n, secs)) if 4 * n >= self.total => (n, secs),
             _ => return deadline,
         };
         let mut keep = secs * (self.total as f64 / n as f64).powf(GROWTH);
@@ -166,10 +167,8 @@ impl Reserve {
 enum Finishing {
     /// After the step check.
     After,
-    /// Alongside it, and not done yet.
+    /// Alongside it, since the time given.
     Alongside,
-    /// Alongside it, and done.
-    Done,
 }
 
 /// Whether `deadline` has passed.
@@ -298,9 +297,12 @@ const STEPS_A_BATCH: usize = 16;
 /// is checked ([`StepsAnalysis::complete`] is false and `steps` ends at the
 /// last step checked), but the finished build is still analysed whole;
 /// when it fails and no checked step did, `first_failure` is the last
-/// step. The check stops early by the time that analysis is expected to
-/// take (from the biggest program solved, once one has a quarter of the
-/// pieces), so that the two end near the deadline.
+/// step. That analysis starts, alongside the steps, at the deadline less
+/// the time it is expected to take (from the biggest program solved, once
+/// one has a quarter of the pieces), so that it ends near the deadline
+/// while the steps go on up to it with the cores it leaves: it is then
+/// [`StepsAnalysis::finished`] as well (a check that stops at a failure
+/// after that point waits for it).
 pub fn analyze_steps_within(
     assembly: &Assembly,
     params: &Params,
@@ -342,15 +344,15 @@ pub fn analyze_steps_told(
     from: u32,
     tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<StepsAnalysis, PhysicsError> {
-    check_steps(
+    let ask = Ask {
         assembly,
         params,
         stop_at_first_failure,
         deadline,
         from,
         tell,
-        None,
-    )
+    };
+    check_steps(&ask, Finish::WhenDue)
 }
 
 /// [`analyze_steps_told`], with the finished model's analysis as well
@@ -380,88 +382,215 @@ pub fn analyze_steps_with_finished(
             "the finished model's analysis given is of another assembly".into(),
         ));
     }
-    check_steps(
+    let ask = Ask {
         assembly,
         params,
         stop_at_first_failure,
         deadline,
         from,
         tell,
-        Some(known),
-    )
+    };
+    check_steps(&ask, known.map_or(Finish::Alongside, Finish::Known))
+}
+
+/// What a step check is asked to do (see [`analyze_steps_told`]).
+struct Ask<'a> {
+    assembly: &'a Assembly,
+    params: &'a Params,
+    stop_at_first_failure: bool,
+    deadline: Option<Instant>,
+    from: u32,
+    tell: Option<&'a dyn Fn(u64, u64)>,
+}
+
+/// When a step check makes the finished model's analysis.
+#[derive(Debug, Clone, Copy)]
+enum Finish<'a> {
+    /// Alongside the steps, from the start.
+    Alongside,
+    /// Alongside the steps once it is due: when the check would otherwise
+    /// stop to keep time for it ([`Reserve`]), which gives the check the
+    /// cores the analysis leaves idle; else (a check that ends in time)
+    /// after them, of the groups the last step did not solve.
+    WhenDue,
+    /// Known already.
+    Known(&'a Analysis),
 }
 
 /// The finished model's groups, solved: each piece's stress and the
 /// seconds it took.
 type Finished = (Vec<PieceStress>, f64);
 
-/// Waits for the finished model's analysis started alongside the steps.
-fn joined(
-    handle: std::thread::ScopedJoinHandle<'_, Result<Finished, PhysicsError>>,
-) -> Result<Finished, PhysicsError> {
-    handle
-        .join()
-        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+/// Where the finished model's analysis is.
+enum State {
+    /// Not started: it starts once due.
+    Due,
+    /// Running since `since`, its answer to come on `answer`; `due`: it
+    /// was started when due, to end near the deadline.
+    Running {
+        answer: Receiver<Result<Finished, PhysicsError>>,
+        since: Instant,
+        due: bool,
+    },
+    /// Made, or given.
+    Done(Finished),
 }
 
-/// [`analyze_steps_told`], and with `finish` (the finished model's
-/// analysis if known) [`analyze_steps_with_finished`].
-fn check_steps(
-    assembly: &Assembly,
-    params: &Params,
-    stop_at_first_failure: bool,
-    deadline: Option<Instant>,
-    from: u32,
-    tell: Option<&dyn Fn(u64, u64)>,
-    finish: Option<Option<&Analysis>>,
-) -> Result<StepsAnalysis, PhysicsError> {
-    let start = Instant::now();
-    params.check()?;
-    let s = Structure::new(assembly, params);
-    let n = assembly.pieces.len();
-    std::thread::scope(|scope| {
-        // The finished model, on a thread of its own (its programs go to
-        // the same pool as the steps').
-        let background = matches!(finish, Some(None)).then(|| {
-            let s = &s;
-            scope.spawn(move || {
-                let begun = Instant::now();
-                solve_all(s, n, params).map(|r| (r, begun.elapsed().as_secs_f64()))
-            })
-        });
-        check_steps_in(
-            assembly,
+/// The finished model's analysis as the step check goes: its programs
+/// are spawned on the rayon pool, ahead of the steps' next batch, so that
+/// one worker takes them while the others go on with the steps.
+struct Finisher<'a, 'scope> {
+    scope: &'a rayon::Scope<'scope>,
+    s: &'scope Structure,
+    params: &'scope Params,
+    /// Pieces of the finished model.
+    n: usize,
+    state: State,
+    /// Whether its programs were solved here.
+    made: bool,
+}
+
+impl<'a, 'scope> Finisher<'a, 'scope> {
+    fn new(
+        scope: &'a rayon::Scope<'scope>,
+        s: &'scope Structure,
+        params: &'scope Params,
+        n: usize,
+        finish: Finish,
+    ) -> Self {
+        let state = match finish {
+            Finish::Known(a) => State::Done((a.pieces.clone(), a.solve_seconds)),
+            Finish::Alongside | Finish::WhenDue => State::Due,
+        };
+        let mut f = Finisher {
+            scope,
+            s,
             params,
-            &s,
-            stop_at_first_failure,
-            deadline,
-            from,
-            tell,
-            start,
-            background,
-            finish
-                .flatten()
-                .map(|a| (a.pieces.clone(), a.solve_seconds)),
-        )
+            n,
+            state,
+            made: false,
+        };
+        if matches!(finish, Finish::Alongside) {
+            f.start(false);
+        }
+        f
+    }
+
+    fn start(&mut self, due: bool) {
+        let (tx, answer) = std::sync::mpsc::channel();
+        let (s, params, n) = (self.s, self.params, self.n);
+        self.scope.spawn(move |_| {
+            let begun = Instant::now();
+            let r = solve_all(s, n, params).map(|r| (r, begun.elapsed().as_secs_f64()));
+            // The check waits for it, unless it failed first.
+            let _ = tx.send(r);
+        });
+        self.made = true;
+        self.state = State::Running {
+            answer,
+            since: Instant::now(),
+            due,
+        };
+    }
+
+    /// Whether the last step takes its answers: it is made, or being made.
+    fn covers_last(&self) -> bool {
+        !matches!(self.state, State::Due)
+    }
+
+    /// The time by which the check stops (see [`Reserve::cut`]): when the
+    /// analysis is not started, `start_when_due` starts it instead of
+    /// stopping for it, and the check may then go on to the deadline.
+    fn cut(
+        &mut self,
+        reserve: &Reserve,
+        deadline: Option<Instant>,
+        start: Instant,
+        start_when_due: bool,
+    ) -> Result<Option<Instant>, PhysicsError> {
+        if let State::Running { answer, .. } = &self.state {
+            match answer.try_recv() {
+                Ok(r) => self.state = State::Done(r?),
+                Err(TryRecvError::Empty) => {}
+                Err(TryRecvError::Disconnected) => return Err(lost()),
+            }
+        }
+        Ok(match &self.state {
+            State::Due => {
+                let cut = reserve.cut(deadline, start, Finishing::After);
+                if start_when_due && past(cut) {
+                    self.start(true);
+                    deadline
+                } else {
+                    cut
+                }
+            }
+            State::Running {
+                since, due: false, ..
+            } => reserve.cut(deadline, *since, Finishing::Alongside),
+            State::Running { due: true, .. } | State::Done(_) => deadline,
+        })
+    }
+
+    /// Waits for the analysis if it runs: its answer, once made.
+    fn wait(&mut self) -> Result<Option<&Finished>, PhysicsError> {
+        if let State::Running { answer, .. } = &self.state {
+            let r = loop {
+                match answer.try_recv() {
+                    Ok(r) => break r,
+                    Err(TryRecvError::Disconnected) => return Err(lost()),
+                    // Called from a worker of the pool, the check helps
+                    // with what is queued there (the analysis itself, it
+                    // may be) rather than block it.
+                    Err(TryRecvError::Empty) => {
+                        if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                            break answer.recv().map_err(|_| lost())?;
+                        }
+                    }
+                }
+            };
+            self.state = State::Done(r?);
+        }
+        Ok(match &self.state {
+            State::Done(f) => Some(f),
+            _ => None,
+        })
+    }
+}
+
+/// The error when the finished model's analysis ended without an answer
+/// (it panicked: the scope passes the panic on).
+fn lost() -> PhysicsError {
+    PhysicsError::Bug("the finished model's analysis ended without an answer".into())
+}
+
+/// [`analyze_steps_told`], and with `finish` [`analyze_steps_with_finished`].
+fn check_steps(ask: &Ask, finish: Finish) -> Result<StepsAnalysis, PhysicsError> {
+    let start = Instant::now();
+    ask.params.check()?;
+    let s = Structure::new(ask.assembly, ask.params);
+    rayon::in_place_scope(|scope| {
+        let mut fin = Finisher::new(scope, &s, ask.params, ask.assembly.pieces.len(), finish);
+        check_steps_in(ask, &s, start, &mut fin)
     })
 }
 
-/// [`check_steps`] once the structure is built, with the finished model's
-/// analysis running in `background`, or `finished` already, when asked
-/// for.
-#[allow(clippy::too_many_arguments)]
+/// [`check_steps`] once the structure is built, with the finished
+/// model's analysis in `fin`.
 fn check_steps_in(
-    assembly: &Assembly,
-    params: &Params,
+    ask: &Ask,
     s: &Structure,
-    stop_at_first_failure: bool,
-    deadline: Option<Instant>,
-    from: u32,
-    tell: Option<&dyn Fn(u64, u64)>,
     start: Instant,
-    mut background: Option<std::thread::ScopedJoinHandle<'_, Result<Finished, PhysicsError>>>,
-    mut finished: Option<Finished>,
+    fin: &mut Finisher,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    let Ask {
+        assembly,
+        params,
+        stop_at_first_failure,
+        deadline,
+        from,
+        tell,
+    } = *ask;
     let n = assembly.pieces.len();
     // (step number, end of its pieces in build order).
     let mut bounds: Vec<(u32, usize)> = Vec::new();
@@ -473,10 +602,10 @@ fn check_steps_in(
     }
     let mut g = Groups::new();
     let (mut next, mut reused, mut solves, mut certified) = (0, 0, 0, 0);
-    let mut current = vec![PieceStress::falling(); assembly.pieces.len()];
+    let mut current = vec![PieceStress::falling(); n];
     // Whether each piece's entry in `current` is exact: found for the
     // group it is in now (see `solve_all_but`).
-    let mut exact = vec![false; assembly.pieces.len()];
+    let mut exact = vec![false; n];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
     // Every step's groups, and whether each needs a solve if everything
@@ -497,6 +626,7 @@ fn check_steps_in(
             reused = before;
         }
     }
+    let last_k = bounds.len().saturating_sub(1);
     let first_batch = if k0 > 0 { k0 + 1 } else { 0 };
     let mut begin = 0;
     let mut ahead: Vec<(usize, usize)> = Vec::new();
@@ -507,10 +637,7 @@ fn check_steps_in(
             continue;
         }
         for (j, job) in jobs.iter().enumerate() {
-            // The last step's groups are the finished model's: with the
-            // finished model solved alongside, they take its answers.
-            let finishing = (background.is_some() || finished.is_some()) && k + 1 == bounds.len();
-            if !(finishing || job.grounded && drops(s, job, begin, end)) {
+            if !(job.grounded && drops(s, job, begin, end)) {
                 ahead.push((k, j));
             }
         }
@@ -519,7 +646,7 @@ fn check_steps_in(
     // The seconds of the biggest program of the step checked last.
     let mut step_seconds = 0.0;
     let mut reserve = Reserve {
-        total: assembly.pieces.len(),
+        total: n,
         biggest: None,
     };
     let mut solved: std::collections::HashMap<(usize, usize), (Vec<PieceStress>, f64)> =
@@ -536,7 +663,7 @@ fn check_steps_in(
             continue;
         }
         if k == k0 && k0 > 0 {
-            if past(reserve.cut(deadline, start, finishing(&background, &finished))) {
+            if past(fin.cut(&reserve, deadline, start, true)?) {
                 complete = false;
                 break;
             }
@@ -559,18 +686,22 @@ fn check_steps_in(
             continue;
         }
         if k >= first_batch && (k - first_batch) % STEPS_A_BATCH == 0 {
-            // Time is kept for the finished model's analysis that follows
-            // a check cut short, so that the two end near the deadline.
-            let cut = reserve.cut(deadline, start, finishing(&background, &finished));
+            // The finished model's analysis, if not made yet, starts by
+            // the time it takes before the deadline, so that the two end
+            // near it.
+            let cut = fin.cut(&reserve, deadline, start, true)?;
             if past(cut) {
                 complete = false;
                 break;
             }
-            // This batch's programs, all at once.
+            // This batch's programs, all at once. The last step's groups
+            // are the finished model's: made alongside, they take its
+            // answers.
             let batch: Vec<(usize, usize)> = ahead
                 .iter()
                 .copied()
                 .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
+                .filter(|&(s, _)| s != last_k || !fin.covers_last())
                 .collect();
             let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
             // A program that would start past the deadline is left out:
@@ -614,14 +745,12 @@ fn check_steps_in(
                 late.push(job);
             }
         }
-        if k + 1 == bounds.len() && !late.is_empty() {
-            if let Some(handle) = background.take() {
-                finished = Some(joined(handle)?);
-                solves += 1;
-            }
-            if let Some((whole, secs)) = &finished {
+        if k == last_k && fin.covers_last() {
+            if let Some((whole, secs)) = fin.wait()? {
                 // The finished model's groups: its answers, exact.
-                step_seconds = *secs;
+                if !late.is_empty() {
+                    step_seconds = *secs;
+                }
                 for job in late.drain(..) {
                     for &p in &job.pieces {
                         current[p] = whole[p];
@@ -630,8 +759,9 @@ fn check_steps_in(
                 }
             }
         }
-        if !late.is_empty() && past(reserve.cut(deadline, start, finishing(&background, &finished)))
-        {
+        // Not started for the last step's own programs: it would solve
+        // the groups the last step has already.
+        if !late.is_empty() && past(fin.cut(&reserve, deadline, start, k != last_k)?) {
             complete = false;
             break;
         }
@@ -657,17 +787,11 @@ fn check_steps_in(
     }
     // The finished build (or the failing step) afresh; past the deadline,
     // the finished build.
-    let end = if complete {
-        begin
-    } else {
-        assembly.pieces.len()
-    };
+    let end = if complete { begin } else { n };
+    let finished = fin.wait()?.cloned();
+    solves += usize::from(fin.made);
     // A complete check has found the last step's groups already, most of
     // them exactly: only the others are solved again.
-    if let Some(handle) = background.take() {
-        finished = Some(joined(handle)?);
-        solves += 1;
-    }
     let (last, last_seconds) = match &finished {
         Some((whole, secs)) if end == n => (whole.clone(), *secs),
         _ => {
@@ -708,20 +832,6 @@ fn check_steps_in(
     })
 }
 
-/// When the finished model's analysis is made: alongside the steps in
-/// `background` (into `finished` once joined), or after them.
-fn finishing<T>(
-    background: &Option<std::thread::ScopedJoinHandle<'_, T>>,
-    finished: &Option<Finished>,
-) -> Finishing {
-    match background {
-        Some(h) if !h.is_finished() => Finishing::Alongside,
-        Some(_) => Finishing::Done,
-        None if finished.is_some() => Finishing::Done,
-        None => Finishing::After,
-    }
-}
-
 /// The check of one intermediate build from its pieces' stress.
 fn check(step: u32, placed: &[PieceStress]) -> StepCheck {
     StepCheck {
@@ -760,7 +870,7 @@ mod tests {
         let kept = (end - cut).as_secs_f64();
         assert!((kept - 2.0 * 2f64.powf(GROWTH)).abs() < 1e-6, "{kept}");
         // Made alongside the check, started 5 s ago: what is left of it is
-        // kept; once done, nothing.
+        // kept.
         let earlier = start.checked_sub(Duration::from_secs(5)).unwrap();
         let cut = r.cut(deadline, earlier, Finishing::Alongside).unwrap();
         let kept = (end - cut).as_secs_f64();
@@ -768,7 +878,6 @@ mod tests {
             (kept - (2.0 * 2f64.powf(GROWTH) - 5.0)).abs() < 0.5,
             "{kept}"
         );
-        assert_eq!(r.cut(deadline, earlier, Finishing::Done), deadline);
         // More than the time there is: the check stops at once.
         r.note(600, Found::Solved, 500.0);
         assert_eq!(r.cut(deadline, start, Finishing::After), Some(start));

@@ -659,7 +659,7 @@ fn support(
         }
         // Steps before the first column stand as they did.
         let from = first_change(asm, &shored.assembly);
-        let c = analyze_steps_from(&shored.assembly, params, true, Some(deadline), from)?;
+        let mut c = analyze_steps_from(&shored.assembly, params, true, Some(deadline), from)?;
         counts.add(&c);
         // Out of time part way: the columns are still kept if the steps
         // checked stand further than before (the report then says the
@@ -676,7 +676,10 @@ fn support(
             .as_ref()
             .map(|m| renumbered(m, asm, &shored.assembly, &supports));
         let partial = stopped_early(&shored.assembly, &c);
-        let finished = (c.first_failure.is_none()).then(|| c.last.clone());
+        // The finished model's analysis, when the check made it: `last`
+        // has every piece, or it was made alongside the steps.
+        let whole = c.last.pieces.len() == shored.assembly.pieces.len();
+        let finished = c.finished.take().or_else(|| whole.then(|| c.last.clone()));
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: spliced(&best.check, from, c),
