@@ -127,8 +127,9 @@ type Answer = (Vec<PieceStress>, Found, f64);
 const GROWTH: f64 = 2.3;
 
 /// The time to keep, before a deadline, for the analysis of the finished
-/// model that follows a check cut short, estimated from the biggest
-/// program solved so far. Programs of less than a quarter of the model
+/// model that a check cut short leaves to make (by the deadline less that
+/// time it is started alongside the steps, or the check stops for it),
+/// estimated from the biggest program solved so far. Programs of less than a quarter of the model
 /// tell nothing (their time is mostly overhead): until one of them is
 /// solved, nothing is kept.
 struct Reserve {
@@ -165,7 +166,7 @@ impl Reserve {
 /// When the finished model's analysis is made, for [`Reserve::cut`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Finishing {
-    /// After the step check.
+    /// Not started: after the step check, or once due.
     After,
     /// Alongside it, since the time given.
     Alongside,
@@ -437,8 +438,9 @@ enum State {
 }
 
 /// The finished model's analysis as the step check goes: its programs
-/// are spawned on the rayon pool, ahead of the steps' next batch, so that
-/// one worker takes them while the others go on with the steps.
+/// are spawned on the rayon pool, from outside it ahead of the steps'
+/// next programs, so that one worker takes them while the others go on
+/// with the steps.
 struct Finisher<'a, 'scope> {
     scope: &'a rayon::Scope<'scope>,
     s: &'scope Structure,
@@ -448,6 +450,11 @@ struct Finisher<'a, 'scope> {
     state: State,
     /// Whether its programs were solved here.
     made: bool,
+    /// Whether programs spawned now run beside the check: it is not on a
+    /// worker of the pool (whose own queue would hold them until the
+    /// check waits), and the pool has more than one worker. Else the
+    /// analysis is not started when due: the check stops for it.
+    overlaps: bool,
 }
 
 impl<'a, 'scope> Finisher<'a, 'scope> {
@@ -469,6 +476,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
             n,
             state,
             made: false,
+            overlaps: rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1,
         };
         if matches!(finish, Finish::Alongside) {
             f.start(false);
@@ -518,7 +526,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
         Ok(match &self.state {
             State::Due => {
                 let cut = reserve.cut(deadline, start, Finishing::After);
-                if start_when_due && past(cut) {
+                if start_when_due && self.overlaps && past(cut) {
                     self.start(true);
                     deadline
                 } else {
@@ -653,6 +661,8 @@ fn check_steps_in(
         std::collections::HashMap::new();
     let mut begin = 0;
     let mut complete = true;
+    // Whether a batch had the last step's programs.
+    let mut last_batched = false;
     let total = bounds.len() as u64;
     for (k, jobs) in all_jobs.iter().enumerate() {
         if let Some(tell) = tell {
@@ -668,11 +678,26 @@ fn check_steps_in(
                 break;
             }
             let (step, end) = bounds[k];
-            let begun = Instant::now();
-            let whole = solve_all(s, end, params)?;
-            step_seconds = begun.elapsed().as_secs_f64();
-            reserve.note(end, Found::Solved, step_seconds);
-            solves += 1;
+            // The last step, whole: the finished model, made alongside.
+            let made = if k == last_k && fin.covers_last() {
+                fin.wait()?.cloned()
+            } else {
+                None
+            };
+            let whole = match made {
+                Some((whole, secs)) => {
+                    step_seconds = secs;
+                    whole
+                }
+                None => {
+                    let begun = Instant::now();
+                    let whole = solve_all(s, end, params)?;
+                    step_seconds = begun.elapsed().as_secs_f64();
+                    reserve.note(end, Found::Solved, step_seconds);
+                    solves += 1;
+                    whole
+                }
+            };
             current[..end].copy_from_slice(&whole);
             exact[..end].fill(true);
             steps.push(check(step, &current[..end]));
@@ -703,6 +728,7 @@ fn check_steps_in(
                 .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
                 .filter(|&(s, _)| s != last_k || !fin.covers_last())
                 .collect();
+            last_batched |= batch.iter().any(|&(s, _)| s == last_k);
             let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
             // A program that would start past the deadline is left out:
             // its step stops the check below (a batch of big programs
@@ -759,9 +785,10 @@ fn check_steps_in(
                 }
             }
         }
-        // Not started for the last step's own programs: it would solve
-        // the groups the last step has already.
-        if !late.is_empty() && past(fin.cut(&reserve, deadline, start, k != last_k)?) {
+        // Not started once the last step's programs are solved or about
+        // to be: it would solve them again.
+        let due = k != last_k && !last_batched;
+        if !late.is_empty() && past(fin.cut(&reserve, deadline, start, due)?) {
             complete = false;
             break;
         }
