@@ -139,7 +139,8 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     };
 
     let pages = booklet.as_ref().map(|b| b.pages);
-    let report = report::compose(opts, &mesh, &model, &settled, hollow, pages, times);
+    let mut report = report::compose(opts, &mesh, &model, &settled, hollow, pages, times);
+    report.warnings.extend(planner.notes());
     progress.stage("writing");
     let report = write::write(
         opts,

@@ -222,6 +222,9 @@ pub(crate) struct Layout<'a> {
     pub slant: Option<&'a Slant>,
     /// Cells no piece may fill: the inside of a hollow build.
     pub keep_empty: Option<&'a VoxelGrid>,
+    /// Cells of `keep_empty` given back to the layout: an inner pillar
+    /// under a piece that could not be put in place over the hollow.
+    pub released: std::collections::HashSet<Cell>,
     /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
@@ -328,6 +331,7 @@ impl<'a> Layout<'a> {
             near,
             slant,
             keep_empty: None,
+            released: std::collections::HashSet::new(),
             colors: None,
             made,
             shapes,
@@ -359,7 +363,7 @@ impl<'a> Layout<'a> {
 
     /// Whether `c` must stay empty (the inside of a hollow build).
     pub fn kept_empty(&self, c: Cell) -> bool {
-        self.keep_empty.is_some_and(|k| k.get(c))
+        self.keep_empty.is_some_and(|k| k.get(c)) && !self.released.contains(&c)
     }
 
     /// Lays every layer, bottom first, until done or `deadline`.

@@ -42,7 +42,8 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::assembly::Placement;
-use crate::grammar::{RuleRef, RuleSet};
+use crate::geom::CellBox;
+use crate::grammar::{Dir, RuleRef, RuleSet};
 use crate::voxel::{Slant, VoxelGrid, Wall};
 pub use prepare::{components, LeftOut, Repairs};
 
@@ -306,23 +307,29 @@ pub fn build_guided(
     layout.join(&mut dice.rules);
     layout.merge();
     let (mut order, mut unreached) = derive::derive(&layout);
-    // A piece pressed on from below with pieces under it, too close to
-    // slide out of the way, cannot be put in place: fill the gap under it
-    // so that it rests on them instead, and derive again.
+    // A piece that cannot be put in place at its turn goes in earlier,
+    // right after a piece it joins, while the way is still open; else the
+    // gap under it is filled so that it rests on the pieces there (inside
+    // a hollow build, a pillar), and the pieces are derived again.
+    let mut blocked = unplaceable(&order, rules.layer_ldu());
     for _ in 0..PLACE_ROUNDS {
-        let blocked = unplaceable(&order, rules.layer_ldu());
         if blocked.is_empty() || Instant::now() >= deadline {
             break;
         }
+        if let Some(left) = move_earlier(&layout, &mut order, &blocked) {
+            blocked = left;
+            continue;
+        }
         let mut changed = false;
-        for p in blocked {
-            changed |= layout.fill_under(&p, &mut dice.rules);
+        for &k in &blocked {
+            changed |= layout.fill_under(&order[k].piece, &mut dice.rules);
         }
         if !changed {
             break;
         }
         layout.join(&mut dice.rules);
         (order, unreached) = derive::derive(&layout);
+        blocked = unplaceable(&order, rules.layer_ldu());
     }
     if order.is_empty() {
         if layout.stats.budget_hit {
@@ -367,8 +374,80 @@ pub fn build_guided(
 /// Rounds of filling gaps under pieces that cannot be put in place.
 const PLACE_ROUNDS: usize = 6;
 
-/// The pieces of `order` the verifier would find cannot be put in place.
-fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<Placement> {
+/// Moves each piece of `order` at the positions `blocked`, which cannot be
+/// put in place at their turn, to the latest earlier turn where it can,
+/// right after a piece it joins by a rule (which becomes its anchor), when
+/// the whole order then has fewer pieces that cannot be put in place: the
+/// positions of those, or `None` if the order is kept.
+fn move_earlier(
+    layout: &layout::Layout,
+    order: &mut Vec<Removal>,
+    blocked: &[usize],
+) -> Option<Vec<usize>> {
+    let u = layout.layer_ldu;
+    let boxes: Vec<CellBox> = order.iter().map(|r| r.piece.body(u).bbox).collect();
+    let mut candidate = order.clone();
+    let mut moved = 0;
+    // From the last, so that earlier positions stay where they were.
+    for &k in blocked.iter().rev() {
+        let p = order[k].piece;
+        let body = p.body(u);
+        let Some(id) = layout.owner_of(body.key()) else {
+            continue;
+        };
+        let (under, over) = (layout.below(&body), layout.above(&body));
+        // Turns right after an earlier piece it joins by a rule, latest
+        // first.
+        let mut turns: Vec<(usize, Placement, Dir)> = Vec::new();
+        for (pos, r) in order[..k].iter().enumerate() {
+            let Some(o) = layout.owner_of(r.piece.body(u).key()) else {
+                continue;
+            };
+            let dir = if under.contains(&o) {
+                Dir::Up
+            } else if over.contains(&o) {
+                Dir::Down
+            } else {
+                continue;
+            };
+            if o != id && layout.book.joint(&r.piece, &p, dir, u).is_some() {
+                turns.push((pos + 1, r.piece, dir));
+            }
+        }
+        let Some(&(at, anchor, dir)) = turns
+            .iter()
+            .rev()
+            .find(|(at, ..)| crate::assembly::verify::placeable_after(&boxes[..*at], &body.bbox))
+        else {
+            continue;
+        };
+        if at >= k {
+            continue;
+        }
+        let rule = layout
+            .book
+            .joint(&anchor, &p, dir, u)
+            .map(|(_, r)| RuleRef::Basic(r));
+        let mut r = candidate.remove(k);
+        r.anchor = Anchor::Piece(anchor);
+        r.rule = rule;
+        candidate.insert(at, r);
+        moved += 1;
+    }
+    if moved == 0 {
+        return None;
+    }
+    let left = unplaceable(&candidate, u);
+    if left.len() >= blocked.len() {
+        return None;
+    }
+    *order = candidate;
+    Some(left)
+}
+
+/// The positions in `order` of the pieces the verifier finds cannot be put
+/// in place at their turn.
+fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<usize> {
     let pieces: Vec<Placement> = order.iter().map(|r| r.piece).collect();
     let asm = crate::assembly::Assembly::from_order(&pieces, layer_ldu, crate::catalog::Color::RED);
     crate::assembly::verify::verify(&asm, None)
@@ -376,7 +455,7 @@ fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<Placement> {
         .iter()
         .filter_map(|f| match f {
             crate::assembly::verify::Failure::NotPlaceable { piece, .. }
-            | crate::assembly::verify::Failure::Enclosed { piece, .. } => Some(pieces[*piece]),
+            | crate::assembly::verify::Failure::Enclosed { piece, .. } => Some(*piece),
             _ => None,
         })
         .collect()
