@@ -387,7 +387,7 @@ fn fill_slots<'a, W: Write + ?Sized>(
 ) -> io::Result<()> {
     let mut rest = template;
     while let Some(at) = rest.find("{{") {
-        w.write_all(rest[..at].as_bytes())?;
+        w.write_all(&rest.as_bytes()[..at])?;
         let after = &rest[at + 2..];
         let end = after
             .find("}}")

@@ -552,12 +552,12 @@ fn check_steps_in(
     // Whether a batch had the last step's programs.
     let mut last_batched = false;
     let total = bounds.len() as u64;
-    for k in 0..bounds.len() {
+    for (k, &(step, end)) in bounds.iter().enumerate() {
         if let Some(tell) = tell {
             tell(k as u64, total);
         }
         if k < k0 {
-            begin = bounds[k].1;
+            begin = end;
             continue;
         }
         if k == k0 && k0 > 0 {
@@ -566,7 +566,6 @@ fn check_steps_in(
                 complete = false;
                 break;
             }
-            let (step, end) = bounds[k];
             // The last step, whole: the finished model, made alongside.
             let made = if k == last_k && fin.covers_last() {
                 fin.wait()?.cloned()
@@ -635,7 +634,6 @@ fn check_steps_in(
         }
         window.make_to(k + 1);
         let jobs = window.take(k);
-        let (step, end) = bounds[k];
         step_seconds = 0.0;
         let mut late = Vec::new();
         for (j, job) in jobs.iter().enumerate() {

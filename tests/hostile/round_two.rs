@@ -163,7 +163,7 @@ fn a_fifo_named_by_a_model_is_refused_without_blocking() {
 /// A glTF document with `nodes` (JSON) and `scene_nodes`, whose mesh 0 is
 /// one triangle.
 fn gltf_with_nodes(nodes: &str, scene_nodes: &str) -> String {
-    let mut bin: Vec<u8> = [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]]
+    let bin: Vec<u8> = [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]]
         .iter()
         .flatten()
         .flat_map(|x| x.to_le_bytes())
@@ -207,7 +207,7 @@ fn an_exponential_or_huge_scene_graph_is_priced_not_walked() {
     // Node 0 holds 12 instances of the triangle (as a cube would hold 12
     // triangles): a million listings are 12 million instances.
     let million = vec!["0"; 1_000_000].join(",");
-    let twelve = vec!["1"; 12].join(",");
+    let twelve = ["1"; 12].join(",");
     let nodes = format!(r#"{{"children": [{twelve}]}}, {{"mesh": 0}}"#);
     std::fs::write(&path, gltf_with_nodes(&nodes, &million)).unwrap();
     let e = refused(&path);
