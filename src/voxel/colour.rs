@@ -189,7 +189,8 @@ fn sample_budget(voxels: usize) -> u64 {
 /// triangle is `(s + 1)(s + 2) / 2` for `s` steps): every third of a cell
 /// over its longest side (`spans`, in cells), at most 4096; then, if the
 /// total passes `budget`, every triangle's steps scaled down alike (at
-/// least 1), so the total stays near the budget whatever the file repeats.
+/// least 1) until it is under, so the total stays at most the budget (or
+/// one step a triangle) whatever the file repeats.
 fn sample_steps(spans: impl Iterator<Item = f32>, budget: u64) -> Vec<u16> {
     let mut steps: Vec<u16> = spans
         .map(|span| (span * 3.0).ceil().clamp(1.0, 4096.0) as u16)
@@ -197,9 +198,19 @@ fn sample_steps(spans: impl Iterator<Item = f32>, budget: u64) -> Vec<u16> {
     let count = |s: u16| (u64::from(s) + 1) * (u64::from(s) + 2) / 2;
     let total: u64 = steps.iter().map(|&s| count(s)).sum();
     if total > budget {
-        let f = (budget as f64 / total as f64).sqrt();
-        for s in &mut steps {
-            *s = ((f64::from(*s) * f).floor() as u16).max(1);
+        let full = steps.clone();
+        let mut f = (budget as f64 / total as f64).sqrt();
+        // The counts' linear terms can leave the first guess a little over:
+        // shrink on until under (or every triangle is at one step).
+        loop {
+            for (s, &n) in steps.iter_mut().zip(&full) {
+                *s = ((f64::from(n) * f).floor() as u16).max(1);
+            }
+            let now: u64 = steps.iter().map(|&s| count(s)).sum();
+            if now <= budget || steps.iter().all(|&s| s == 1) {
+                break;
+            }
+            f *= 0.97;
         }
     }
     steps
