@@ -17,7 +17,10 @@
 //!    rests on nothing the rules join is joined to another by growing one of
 //!    its pieces or laying a piece across, with the fewest cells outside;
 //!    `merge` then makes neighbours whose union is a piece of the alphabet
-//!    one piece: never a seam more, always a piece fewer;
+//!    one piece: never a seam more, always a piece fewer; and `cap`, where
+//!    the alphabet has slopes, swaps the row of a brick that stands a step
+//!    above its neighbours (below, underneath) for slopes facing down the
+//!    step, so a slanted roof is capped rather than a staircase;
 //! 4. `derive`: the pieces ordered as a derivation: a starting rule, then
 //!    each piece added by the heaviest rule joining it to a piece already
 //!    there, lowest course first.
@@ -26,6 +29,7 @@
 //! piece scored against a fixed set of candidates over it, and bodies are
 //! tracked with a union-find.
 
+mod cap;
 mod complex;
 mod derive;
 mod join;
@@ -128,6 +132,9 @@ pub struct SearchStats {
     pub complex_tried: u64,
     /// Complex rules applied (each one node adding all its new pieces).
     pub complex_applied: u64,
+    /// Slopes laid after the layout to cap stair edges (inverted slopes
+    /// underneath), each in place of a brick's row along the step.
+    pub caps: u64,
     /// Whether the time budget ran out before every layer was laid.
     pub budget_hit: bool,
 }
@@ -305,6 +312,7 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
+    layout.stats.caps = layout.cap_stairs() as u64;
     let (mut order, mut unreached) = derive::derive(&layout);
     // A piece pressed on from below with pieces under it, too close to
     // slide out of the way, cannot be put in place: fill the gap under it
