@@ -120,25 +120,45 @@ impl<'a> Planner<'a> {
 
     /// [`Self::plan`]; `told`: the layout's progress is shown.
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
-        let (outcome, assembly) = self.layout(seed, told)?;
+        let (outcome, assembly) = self.layout(seed, told, true)?;
         let t = Instant::now();
-        let (assembly, order) = self.order(&outcome, assembly)?;
+        let ordered = self.order(&outcome, assembly);
         self.verify_secs.set(self.verify_secs.get() + secs(t));
-        Ok((outcome, assembly, order))
+        match ordered {
+            Ok((assembly, order)) => Ok((outcome, assembly, order)),
+            // The slopes capping the stairs are the one late change to the
+            // layout: a build they leave unverified is laid without them.
+            Err(BuildError::Unverified { .. })
+                if self.opts.search.cap_stairs && self.opts.slopes =>
+            {
+                let (outcome, assembly) = self.layout(seed, false, false)?;
+                let t = Instant::now();
+                let (assembly, order) = self.order(&outcome, assembly)?;
+                self.verify_secs.set(self.verify_secs.get() + secs(t));
+                Ok((outcome, assembly, order))
+            }
+            Err(e) => Err(e),
+        }
     }
 
     /// The search's pieces for `seed`, painted; `told`: how far it is
-    /// goes to the progress display.
+    /// goes to the progress display; `cap`: stair edges are capped with
+    /// slopes (see [`SearchOptions::cap_stairs`]).
     pub(super) fn layout(
         &self,
         seed: u64,
         told: bool,
+        cap: bool,
     ) -> Result<(SearchOutcome, Assembly), BuildError> {
         let opts = self.opts;
         let model = &self.voxels.model;
         let tell = |done, total| self.progress.advance(done, total);
         let guide = self.guide(told.then_some(&tell as &dyn Fn(u64, u64)));
-        let search_opts = opts.search.clone().with_seed(seed);
+        let search_opts = opts
+            .search
+            .clone()
+            .with_seed(seed)
+            .with_cap_stairs(cap && opts.search.cap_stairs);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
                 file: self.file.clone(),

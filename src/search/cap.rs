@@ -30,17 +30,29 @@ use crate::grammar::Dir;
 /// slant the slope's way: a brick's height.
 const SLANT_DEPTH: i32 = 2;
 
+/// One brick swapped for slopes (and a shorter brick).
+#[derive(Debug, Clone)]
+pub(crate) struct Swap {
+    /// The brick taken out.
+    brick: u32,
+    /// The pieces laid in its place.
+    laid: std::ops::Range<u32>,
+    /// How many of them are slopes.
+    pub slopes: usize,
+}
+
 /// The four horizontal directions a step can fall.
 const DIRS: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
 
 impl Layout<'_> {
     /// Caps stair edges with slopes (on top) and inverted slopes
-    /// (underneath) where the alphabet has them; returns the slopes laid.
-    pub fn cap_stairs(&mut self) -> usize {
+    /// (underneath) where the alphabet has them; returns the swaps made.
+    pub fn cap_stairs(&mut self) -> Vec<Swap> {
         let has = |s: Shape| self.shapes.iter().any(|p| p.part.spec().shape == s);
         let (top, under) = (has(Shape::Slope), has(Shape::Inverted));
+        let mut swaps = Vec::new();
         if !top && !under {
-            return 0;
+            return swaps;
         }
         // Half-brick layers only: bricks two layers tall.
         let bricks: Vec<u32> = (0..self.pieces.len() as u32)
@@ -66,15 +78,37 @@ impl Layout<'_> {
                 (if kind == Shape::Slope { z } else { -z }, id)
             });
             for id in order {
-                if !self.pieces[id as usize].gone {
-                    laid += self.cap_piece(id, kind).unwrap_or(0);
+                if self.pieces[id as usize].gone {
+                    continue;
+                }
+                let first = self.pieces.len() as u32;
+                if let Some(k) = self.cap_piece(id, kind) {
+                    laid += k;
+                    swaps.push(Swap {
+                        brick: id,
+                        laid: first..self.pieces.len() as u32,
+                        slopes: k,
+                    });
                 }
             }
         }
         if laid > 0 {
             self.rebuild_bodies();
         }
-        laid
+        swaps
+    }
+
+    /// Undoes `swaps` (the bricks back, the slopes out), last first.
+    pub fn uncap(&mut self, swaps: &[Swap]) {
+        for s in swaps.iter().rev() {
+            for id in s.laid.clone() {
+                self.remove(id);
+            }
+            self.restore(s.brick);
+        }
+        if !swaps.is_empty() {
+            self.rebuild_bodies();
+        }
     }
 
     /// Swaps the row of piece `id` along its side that falls most for
@@ -125,14 +159,14 @@ impl Layout<'_> {
                     // resting on a piece.
                     let f = Cell::new(n.x, n.y, b.min.z);
                     self.free_cell(f)
-                        && self.free_cell(f.offset(0, 0, 1))
+                        && self.clear_column(f, 1)
                         && self.owner_of(f.offset(0, 0, -1)).is_some()
                 } else {
                     // Front row at the brick's top layer, open below,
                     // holding a piece above.
                     let f = Cell::new(n.x, n.y, b.min.z + b.sz - 1);
                     self.free_cell(f)
-                        && self.free_cell(f.offset(0, 0, -1))
+                        && self.clear_column(f, -1)
                         && self.owner_of(f.offset(0, 0, 1)).is_some()
                 }
             })
@@ -158,6 +192,21 @@ impl Layout<'_> {
             sz: 1,
         };
         side.cells().collect::<Vec<_>>().into_iter()
+    }
+
+    /// Whether the cells from `f` up (`dz` 1) or down (-1) are free of
+    /// pieces and of the model's voxels to the grid's end: a slope's front
+    /// row must be open to the outside over its face, or the pieces around
+    /// it would enclose it and it could not be put in place.
+    fn clear_column(&self, f: Cell, dz: i32) -> bool {
+        let mut q = f.offset(0, 0, dz);
+        while self.must.in_bounds(q) {
+            if !self.free_cell(q) || self.must.get(q) {
+                return false;
+            }
+            q = q.offset(0, 0, dz);
+        }
+        true
     }
 
     /// A cell in the grid, owned by no piece and not kept empty.

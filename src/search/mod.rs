@@ -69,6 +69,9 @@ pub struct SearchOptions {
     /// Build a shell with walls this thick and the inside empty (see
     /// [`crate::voxel::hollow()`]); `None`, the default, builds solid.
     pub hollow: Option<Wall>,
+    /// Cap stair edges with slopes after the layout, where the rules have
+    /// slopes. Default `true`.
+    pub cap_stairs: bool,
 }
 
 impl Default for SearchOptions {
@@ -78,6 +81,7 @@ impl Default for SearchOptions {
             time_budget: Duration::from_secs(300),
             complex_every: 0,
             hollow: None,
+            cap_stairs: true,
         }
     }
 }
@@ -98,6 +102,12 @@ impl SearchOptions {
     /// Builds hollow with walls `wall` thick (`None`: solid).
     pub fn with_hollow(mut self, wall: Option<Wall>) -> Self {
         self.hollow = wall;
+        self
+    }
+
+    /// Sets whether stair edges are capped with slopes after the layout.
+    pub fn with_cap_stairs(mut self, cap: bool) -> Self {
+        self.cap_stairs = cap;
         self
     }
 
@@ -312,8 +322,22 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
-    layout.stats.caps = layout.cap_stairs() as u64;
+    let swaps = if opts.cap_stairs {
+        layout.cap_stairs()
+    } else {
+        Vec::new()
+    };
     let (mut order, mut unreached) = derive::derive(&layout);
+    // Slopes capping the stairs must not cost the build its order: if a
+    // piece cannot be put in place or reached with them, they are undone.
+    if !swaps.is_empty()
+        && (!unreached.is_empty() || !unplaceable(&order, rules.layer_ldu()).is_empty())
+    {
+        layout.uncap(&swaps);
+        (order, unreached) = derive::derive(&layout);
+    } else {
+        layout.stats.caps = swaps.iter().map(|s| s.slopes as u64).sum();
+    }
     // A piece pressed on from below with pieces under it, too close to
     // slide out of the way, cannot be put in place: fill the gap under it
     // so that it rests on them instead, and derive again.
