@@ -6,7 +6,7 @@
 # OPTIONS (default: a `;`-separated list: the default options, --hollow,
 # --slopes, --plates, --palette layers) and STABILITY (default "off"; set it
 # to "repair" to run the stability stage too, with BUDGET seconds, default
-# 20) override. Prints one line a failing run and a summary; exits 1 if any
+# 20) and BIN (a brickwright binary; default: this tree's, built) override. Prints one line a failing run and a summary; exits 1 if any
 # run failed.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -15,8 +15,10 @@ seeds=${SEEDS:-"1 2 3"}
 options=${OPTIONS:-";--hollow;--slopes;--plates;--palette layers"}
 stability=${STABILITY:-off}
 budget=${BUDGET:-20}
-bin=target/release/brickwright
-cargo build --release --quiet
+bin=${BIN:-target/release/brickwright}
+if [ -z "${BIN:-}" ]; then
+    cargo build --release --quiet
+fi
 if [ $# -eq 0 ]; then
     set -- fixtures/*.obj fixtures/*.stl fixtures/*.glb fixtures/*.gltf
 fi

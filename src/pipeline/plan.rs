@@ -133,27 +133,37 @@ impl<'a> Planner<'a> {
     /// so; if none verifies, the first failure is the error (a bug).
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
         let mut first_failure = None;
+        // The slopes capping the stairs are the one late change to the
+        // layout: a build they leave unverified is laid without them too.
+        let caps: &[bool] = if self.opts.search.cap_stairs && self.opts.slopes {
+            &[true, false]
+        } else {
+            &[true]
+        };
         for k in 0..=RELAYOUTS {
-            let s = seed.wrapping_add(k * RELAYOUT_STRIDE);
-            let (outcome, assembly) = self.layout(s, told && k == 0)?;
-            let t = Instant::now();
-            let ordered = self.order(&outcome, assembly);
-            self.verify_secs.set(self.verify_secs.get() + secs(t));
-            match ordered {
-                Ok((assembly, order)) => {
-                    if let Some(BuildError::Unverified { report, .. }) = &first_failure {
-                        self.notes.borrow_mut().push(format!(
-                            "{}: the layout with seed {seed} failed verification ({}); the build is the layout with seed {s}, which passed",
-                            self.file,
-                            report.lines().nth(1).unwrap_or(report).trim_start_matches(['-', ' '])
-                        ));
+            for &cap in caps {
+                let s = seed.wrapping_add(k * RELAYOUT_STRIDE);
+                let (outcome, assembly) = self.layout(s, told && k == 0 && cap, cap)?;
+                let t = Instant::now();
+                let ordered = self.order(&outcome, assembly);
+                self.verify_secs.set(self.verify_secs.get() + secs(t));
+                match ordered {
+                    Ok((assembly, order)) => {
+                        if let Some(BuildError::Unverified { report, .. }) = &first_failure {
+                            self.notes.borrow_mut().push(format!(
+                                "{}: the layout with seed {seed} failed verification ({}); the build is the layout with seed {s}{}, which passed",
+                                self.file,
+                                report.lines().nth(1).unwrap_or(report).trim_start_matches(['-', ' ']),
+                                if cap { "" } else { " without the slopes capping its stairs" }
+                            ));
+                        }
+                        return Ok((outcome, assembly, order));
                     }
-                    return Ok((outcome, assembly, order));
+                    Err(e @ BuildError::Unverified { .. }) => {
+                        first_failure.get_or_insert(e);
+                    }
+                    Err(e) => return Err(e),
                 }
-                Err(e @ BuildError::Unverified { .. }) => {
-                    first_failure.get_or_insert(e);
-                }
-                Err(e) => return Err(e),
             }
         }
         Err(first_failure.expect("a failure was kept"))
@@ -166,17 +176,23 @@ impl<'a> Planner<'a> {
     }
 
     /// The search's pieces for `seed`, painted; `told`: how far it is
-    /// goes to the progress display.
+    /// goes to the progress display; `cap`: stair edges are capped with
+    /// slopes (see [`SearchOptions::cap_stairs`]).
     pub(super) fn layout(
         &self,
         seed: u64,
         told: bool,
+        cap: bool,
     ) -> Result<(SearchOutcome, Assembly), BuildError> {
         let opts = self.opts;
         let model = &self.voxels.model;
         let tell = |done, total| self.progress.advance(done, total);
         let guide = self.guide(told.then_some(&tell as &dyn Fn(u64, u64)));
-        let search_opts = opts.search.clone().with_seed(seed);
+        let search_opts = opts
+            .search
+            .clone()
+            .with_seed(seed)
+            .with_cap_stairs(cap && opts.search.cap_stairs);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
                 file: self.file.clone(),

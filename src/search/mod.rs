@@ -17,7 +17,10 @@
 //!    rests on nothing the rules join is joined to another by growing one of
 //!    its pieces or laying a piece across, with the fewest cells outside;
 //!    `merge` then makes neighbours whose union is a piece of the alphabet
-//!    one piece: never a seam more, always a piece fewer;
+//!    one piece: never a seam more, always a piece fewer; and `cap`, where
+//!    the alphabet has slopes, swaps the row of a brick that stands a step
+//!    above its neighbours (below, underneath) for slopes facing down the
+//!    step, so a slanted roof is capped rather than a staircase;
 //! 4. `derive`: the pieces ordered as a derivation: a starting rule, then
 //!    each piece added by the heaviest rule joining it to a piece already
 //!    there, lowest course first.
@@ -26,6 +29,7 @@
 //! piece scored against a fixed set of candidates over it, and bodies are
 //! tracked with a union-find.
 
+mod cap;
 mod complex;
 mod derive;
 mod join;
@@ -66,6 +70,9 @@ pub struct SearchOptions {
     /// Build a shell with walls this thick and the inside empty (see
     /// [`crate::voxel::hollow()`]); `None`, the default, builds solid.
     pub hollow: Option<Wall>,
+    /// Cap stair edges with slopes after the layout, where the rules have
+    /// slopes. Default `true`.
+    pub cap_stairs: bool,
 }
 
 impl Default for SearchOptions {
@@ -75,6 +82,7 @@ impl Default for SearchOptions {
             time_budget: Duration::from_secs(300),
             complex_every: 0,
             hollow: None,
+            cap_stairs: true,
         }
     }
 }
@@ -95,6 +103,12 @@ impl SearchOptions {
     /// Builds hollow with walls `wall` thick (`None`: solid).
     pub fn with_hollow(mut self, wall: Option<Wall>) -> Self {
         self.hollow = wall;
+        self
+    }
+
+    /// Sets whether stair edges are capped with slopes after the layout.
+    pub fn with_cap_stairs(mut self, cap: bool) -> Self {
+        self.cap_stairs = cap;
         self
     }
 
@@ -129,6 +143,9 @@ pub struct SearchStats {
     pub complex_tried: u64,
     /// Complex rules applied (each one node adding all its new pieces).
     pub complex_applied: u64,
+    /// Slopes laid after the layout to cap stair edges (inverted slopes
+    /// underneath), each in place of a brick's row along the step.
+    pub caps: u64,
     /// Whether the time budget ran out before every layer was laid.
     pub budget_hit: bool,
 }
@@ -306,12 +323,26 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
+    let swaps = if opts.cap_stairs {
+        layout.cap_stairs()
+    } else {
+        Vec::new()
+    };
     let (mut order, mut unreached) = derive::derive(&layout);
+    let mut blocked = unplaceable(&order, rules.layer_ldu());
+    // Slopes capping the stairs must not cost the build its order: if a
+    // piece cannot be put in place or reached with them, they are undone.
+    if !swaps.is_empty() && (!unreached.is_empty() || !blocked.is_empty()) {
+        layout.uncap(&swaps);
+        (order, unreached) = derive::derive(&layout);
+        blocked = unplaceable(&order, rules.layer_ldu());
+    } else {
+        layout.stats.caps = swaps.iter().map(|s| s.slopes as u64).sum();
+    }
     // A piece that cannot be put in place at its turn goes in earlier,
     // right after a piece it joins, while the way is still open; else the
     // gap under it is filled so that it rests on the pieces there (inside
     // a hollow build, a pillar), and the pieces are derived again.
-    let mut blocked = unplaceable(&order, rules.layer_ldu());
     for _ in 0..PLACE_ROUNDS {
         if blocked.is_empty() || Instant::now() >= deadline {
             break;
