@@ -417,10 +417,9 @@ fn move_earlier(
 ) -> Option<Vec<usize>> {
     let u = layout.layer_ldu;
     let boxes: Vec<CellBox> = order.iter().map(|r| r.piece.body(u).bbox).collect();
-    let mut candidate = order.clone();
-    let mut moved = 0;
-    // From the last, so that earlier positions stay where they were.
-    for &k in blocked.iter().rev() {
+    // (from, to, the piece with its new anchor), each judged on `order`.
+    let mut moves: Vec<(usize, usize, Removal)> = Vec::new();
+    for &k in blocked {
         let p = order[k].piece;
         let body = p.body(u);
         let Some(id) = layout.owner_of(body.key()) else {
@@ -459,17 +458,31 @@ fn move_earlier(
             .book
             .joint(&anchor, &p, dir, u)
             .map(|(_, r)| RuleRef::Basic(r));
-        let mut r = candidate.remove(k);
+        let mut r = order[k];
         r.anchor = Anchor::Piece(anchor);
         r.rule = rule;
-        candidate.insert(at, r);
-        moved += 1;
+        moves.push((k, at, r));
     }
-    if moved == 0 {
+    if moves.is_empty() {
         return None;
     }
-    let left = unplaceable(&candidate, u);
-    if left.len() >= blocked.len() {
+    // Each moved piece goes in right before the piece at its new turn
+    // (several at one turn in their old order), the rest in their order.
+    moves.sort_by_key(|&(k, at, _)| (at, k));
+    let from: std::collections::HashSet<usize> = moves.iter().map(|m| m.0).collect();
+    let mut candidate = Vec::with_capacity(order.len());
+    let mut next = moves.iter().peekable();
+    for (i, r) in order.iter().enumerate() {
+        while let Some((_, _, m)) = next.next_if(|m| m.1 == i) {
+            candidate.push(*m);
+        }
+        if !from.contains(&i) {
+            candidate.push(*r);
+        }
+    }
+    // Better only if fewer pieces are shut in and nothing else broke.
+    let (left, others) = unplaceable_and_others(&candidate, u);
+    if others > 0 || left.len() >= blocked.len() {
         return None;
     }
     *order = candidate;
@@ -479,17 +492,30 @@ fn move_earlier(
 /// The positions in `order` of the pieces the verifier finds cannot be put
 /// in place at their turn.
 fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<usize> {
+    unplaceable_and_others(order, layer_ldu).0
+}
+
+/// [`unplaceable`], and how many other failures the verifier finds (but
+/// a build in more than one part, which the derivation leaves to its
+/// caller).
+fn unplaceable_and_others(order: &[Removal], layer_ldu: i32) -> (Vec<usize>, usize) {
+    use crate::assembly::verify::Failure;
     let pieces: Vec<Placement> = order.iter().map(|r| r.piece).collect();
     let asm = crate::assembly::Assembly::from_order(&pieces, layer_ldu, crate::catalog::Color::RED);
-    crate::assembly::verify::verify(&asm, None)
+    let mut others = 0;
+    let blocked = crate::assembly::verify::verify(&asm, None)
         .failures
         .iter()
         .filter_map(|f| match f {
-            crate::assembly::verify::Failure::NotPlaceable { piece, .. }
-            | crate::assembly::verify::Failure::Enclosed { piece, .. } => Some(*piece),
-            _ => None,
+            Failure::NotPlaceable { piece, .. } | Failure::Enclosed { piece, .. } => Some(*piece),
+            Failure::Disconnected { .. } => None,
+            _ => {
+                others += 1;
+                None
+            }
         })
-        .collect()
+        .collect();
+    (blocked, others)
 }
 
 /// The search's seeded random streams: one draws among scored candidates,
