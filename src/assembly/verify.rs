@@ -307,7 +307,7 @@ fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
 ///
 /// Found through the cells under each piece, so the time grows with the
 /// pieces' footprints, not with the square of the pieces in a layer. A
-/// cell remembers the first [`MAX_OVERLAPS_PER_PIECE`] pieces whose bottom
+/// cell remembers the first `MAX_OVERLAPS_PER_PIECE` (8) pieces whose bottom
 /// covers it: in a build without overlaps there is one at most, and a file
 /// stacking thousands of copies on one spot (each an overlap already) gives
 /// a bounded number of pairs instead of the square of the copies.
