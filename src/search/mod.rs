@@ -402,7 +402,8 @@ pub fn build_guided(
     })
 }
 
-/// Rounds of filling gaps under pieces that cannot be put in place.
+/// Rounds of repairs of pieces that cannot be put in place: moves to an
+/// earlier turn, or fills of the gap under them.
 const PLACE_ROUNDS: usize = 6;
 
 /// Moves each piece of `order` at the positions `blocked`, which cannot be
@@ -428,7 +429,7 @@ fn move_earlier(
         let (under, over) = (layout.below(&body), layout.above(&body));
         // Turns right after an earlier piece it joins by a rule, latest
         // first.
-        let mut turns: Vec<(usize, Placement, Dir)> = Vec::new();
+        let mut turns: Vec<(usize, Placement, RuleRef)> = Vec::new();
         for (pos, r) in order[..k].iter().enumerate() {
             let Some(o) = layout.owner_of(r.piece.body(u).key()) else {
                 continue;
@@ -440,11 +441,14 @@ fn move_earlier(
             } else {
                 continue;
             };
-            if o != id && layout.book.joint(&r.piece, &p, dir, u).is_some() {
-                turns.push((pos + 1, r.piece, dir));
+            if o == id {
+                continue;
+            }
+            if let Some((_, rule)) = layout.book.joint(&r.piece, &p, dir, u) {
+                turns.push((pos + 1, r.piece, RuleRef::Basic(rule)));
             }
         }
-        let Some(&(at, anchor, dir)) = turns
+        let Some(&(at, anchor, rule)) = turns
             .iter()
             .rev()
             .find(|(at, ..)| crate::assembly::verify::placeable_after(&boxes[..*at], &body.bbox))
@@ -454,13 +458,9 @@ fn move_earlier(
         if at >= k {
             continue;
         }
-        let rule = layout
-            .book
-            .joint(&anchor, &p, dir, u)
-            .map(|(_, r)| RuleRef::Basic(r));
         let mut r = order[k];
         r.anchor = Anchor::Piece(anchor);
-        r.rule = rule;
+        r.rule = Some(rule);
         moves.push((k, at, r));
     }
     if moves.is_empty() {
