@@ -338,15 +338,18 @@ impl Layout<'_> {
                 // cavity the table closes).
                 let on_table = dz < 0 && q.z < 0;
                 if (q.z >= 0 && q.z < nz) || on_table {
+                    // The inside of a hollow build under the piece becomes
+                    // a pillar: nothing else can reach the piece there once
+                    // the shell closes. Over it, the hollow stays.
+                    if dz < 0 {
+                        for &c in &col {
+                            if self.kept_empty(c) {
+                                self.released.insert(c);
+                            }
+                        }
+                    }
                     gap.extend(col);
                 }
-            }
-        }
-        // The inside of a hollow build under the piece becomes a pillar:
-        // nothing else can reach the piece there once the shell closes.
-        for &c in &gap {
-            if self.kept_empty(c) {
-                self.released.insert(c);
             }
         }
         gap.sort_by_key(|c| (c.z, c.y, c.x));
