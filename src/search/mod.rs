@@ -37,6 +37,7 @@ mod layout;
 mod merge;
 mod prepare;
 mod rulebook;
+mod sequence;
 
 use std::time::{Duration, Instant};
 
@@ -46,8 +47,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::assembly::Placement;
-use crate::geom::CellBox;
-use crate::grammar::{Dir, RuleRef, RuleSet};
+use crate::grammar::{RuleRef, RuleSet};
 use crate::voxel::{Slant, VoxelGrid, Wall};
 pub use prepare::{components, LeftOut, Repairs};
 
@@ -328,28 +328,24 @@ pub fn build_guided(
     } else {
         Vec::new()
     };
-    let (mut order, mut unreached) = derive::derive(&layout);
+    let (mut order, mut unreached) = derive(&layout);
     let mut blocked = unplaceable(&order, rules.layer_ldu());
     // Slopes capping the stairs must not cost the build its order: if a
     // piece cannot be put in place or reached with them, they are undone.
     if !swaps.is_empty() && (!unreached.is_empty() || !blocked.is_empty()) {
         layout.uncap(&swaps);
-        (order, unreached) = derive::derive(&layout);
+        (order, unreached) = derive(&layout);
         blocked = unplaceable(&order, rules.layer_ldu());
     } else {
         layout.stats.caps = swaps.iter().map(|s| s.slopes as u64).sum();
     }
-    // A piece that cannot be put in place at its turn goes in earlier,
-    // right after a piece it joins, while the way is still open; else the
-    // gap under it is filled so that it rests on the pieces there (inside
-    // a hollow build, a pillar), and the pieces are derived again.
+    // A piece that no order can put in place (one hanging in a cavity from
+    // the piece that closes it) gets the gap under it filled, so that it
+    // rests on the pieces there (inside a hollow build, a pillar), and the
+    // pieces are ordered again.
     for _ in 0..PLACE_ROUNDS {
         if blocked.is_empty() || Instant::now() >= deadline {
             break;
-        }
-        if let Some(left) = move_earlier(&layout, &mut order, &blocked) {
-            blocked = left;
-            continue;
         }
         let mut changed = false;
         for &k in &blocked {
@@ -359,7 +355,7 @@ pub fn build_guided(
             break;
         }
         layout.join(&mut dice.rules);
-        (order, unreached) = derive::derive(&layout);
+        (order, unreached) = derive(&layout);
         blocked = unplaceable(&order, rules.layer_ldu());
     }
     if order.is_empty() {
@@ -402,91 +398,22 @@ pub fn build_guided(
     })
 }
 
-/// Rounds of repairs of pieces that cannot be put in place: moves to an
-/// earlier turn, or fills of the gap under them.
+/// Rounds of repairs of pieces that no order puts in place: fills of the
+/// gap under them.
 const PLACE_ROUNDS: usize = 6;
 
-/// Moves each piece of `order` at the positions `blocked`, which cannot be
-/// put in place at their turn, to the latest earlier turn where it can,
-/// right after a piece it joins by a rule (which becomes its anchor), when
-/// the whole order then has fewer pieces that cannot be put in place: the
-/// positions of those, or `None` if the order is kept.
-fn move_earlier(
-    layout: &layout::Layout,
-    order: &mut Vec<Removal>,
-    blocked: &[usize],
-) -> Option<Vec<usize>> {
-    let u = layout.layer_ldu;
-    let boxes: Vec<CellBox> = order.iter().map(|r| r.piece.body(u).bbox).collect();
-    // (from, to, the piece with its new anchor), each judged on `order`.
-    let mut moves: Vec<(usize, usize, Removal)> = Vec::new();
-    for &k in blocked {
-        let p = order[k].piece;
-        let body = p.body(u);
-        let Some(id) = layout.owner_of(body.key()) else {
-            continue;
-        };
-        let (under, over) = (layout.below(&body), layout.above(&body));
-        // Turns right after an earlier piece it joins by a rule, latest
-        // first.
-        let mut turns: Vec<(usize, Placement, RuleRef)> = Vec::new();
-        for (pos, r) in order[..k].iter().enumerate() {
-            let Some(o) = layout.owner_of(r.piece.body(u).key()) else {
-                continue;
-            };
-            let dir = if under.contains(&o) {
-                Dir::Up
-            } else if over.contains(&o) {
-                Dir::Down
-            } else {
-                continue;
-            };
-            if o == id {
-                continue;
-            }
-            if let Some((_, rule)) = layout.book.joint(&r.piece, &p, dir, u) {
-                turns.push((pos + 1, r.piece, RuleRef::Basic(rule)));
-            }
-        }
-        let Some(&(at, anchor, rule)) = turns
-            .iter()
-            .rev()
-            .find(|(at, ..)| crate::assembly::verify::placeable_after(&boxes[..*at], &body.bbox))
-        else {
-            continue;
-        };
-        if at >= k {
-            continue;
-        }
-        let mut r = order[k];
-        r.anchor = Anchor::Piece(anchor);
-        r.rule = Some(rule);
-        moves.push((k, at, r));
+/// The laid pieces as a derivation, in an order that puts each piece in
+/// place at its turn where one exists (`sequence`), and the pieces no rule
+/// reaches.
+fn derive(layout: &layout::Layout) -> (Vec<Removal>, Vec<u32>) {
+    let (order, unreached) = derive::derive(layout);
+    // The derivation's own order stands where the verifier finds every
+    // piece placeable; else the model is taken apart to find one.
+    if unplaceable(&order, layout.layer_ldu).is_empty() {
+        return (order, unreached);
     }
-    if moves.is_empty() {
-        return None;
-    }
-    // Each moved piece goes in right before the piece at its new turn
-    // (several at one turn in their old order), the rest in their order.
-    moves.sort_by_key(|&(k, at, _)| (at, k));
-    let from: std::collections::HashSet<usize> = moves.iter().map(|m| m.0).collect();
-    let mut candidate = Vec::with_capacity(order.len());
-    let mut next = moves.iter().peekable();
-    for (i, r) in order.iter().enumerate() {
-        while let Some((_, _, m)) = next.next_if(|m| m.1 == i) {
-            candidate.push(*m);
-        }
-        if !from.contains(&i) {
-            candidate.push(*r);
-        }
-    }
-    // Better only if fewer pieces are shut in and nothing else broke.
-    let (left, others) = unplaceable_and_others(&candidate, u);
-    if others > 0 || left.len() >= blocked.len() {
-        return None;
-    }
-    *order = candidate;
-    Some(left)
+    let (order, _forced) = sequence::sequence(layout, order);
+    (order, unreached)
 }
 
 /// The positions in `order` of the pieces the verifier finds cannot be put
