@@ -192,12 +192,7 @@ fn formats_choose_the_files_written() {
 }
 
 fn xmllint() -> Option<PathBuf> {
-    let found = Command::new("xmllint").arg("--version").output().is_ok();
-    if found {
-        return Some(PathBuf::from("xmllint"));
-    }
-    common::missing_tool("xmllint", "apt-get install libxml2-utils");
-    None
+    common::tool("xmllint", "libxml2-utils").then(|| PathBuf::from("xmllint"))
 }
 
 #[test]
