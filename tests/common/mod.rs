@@ -5,7 +5,8 @@
 //!   with Xvfb and ImageMagick) asks for it with [`tool`] (or
 //!   [`required_tool`], [`gltf_validator`]). Outside CI a missing tool skips
 //!   that check, and the first such request of the run probes every tool
-//!   and prints one notice to standard error: which checks are skipped and
+//!   and prints one notice to standard error (once a `cargo test` run, not
+//!   once a test binary): which checks are skipped and
 //!   the command that installs what they need (`.ci/run tools`). Under CI
 //!   (any non-empty `CI`, which `.ci/run` sets) a missing tool fails the
 //!   test naming it, so a green CI run means every check really ran;
@@ -147,7 +148,7 @@ fn missing_tools() -> &'static [&'static str] {
             })
             .map(|t| t.name)
             .collect();
-        if !missing.is_empty() && may_skip_tools() {
+        if !missing.is_empty() && may_skip_tools() && first_notice_of_this_run() {
             // Straight to the process's standard error: the test harness
             // captures `eprintln!`, and this must be seen.
             let _ = std::io::stderr()
@@ -156,6 +157,22 @@ fn missing_tools() -> &'static [&'static str] {
         }
         missing
     })
+}
+
+/// Whether no other test binary of this `cargo test` run has printed the
+/// notice: the binaries of one run are children of one cargo process, so
+/// the first to create a marker named by that process's id prints it.
+fn first_notice_of_this_run() -> bool {
+    let marker = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "outside-tools-notice-{}",
+        std::os::unix::process::parent_id()
+    ));
+    // A marker that cannot be made (a read-only target) means printing
+    // again, never staying silent.
+    !matches!(
+        std::fs::OpenOptions::new().write(true).create_new(true).open(&marker),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists
+    )
 }
 
 /// The notice printed once a run when outside tools are missing.
