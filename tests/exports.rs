@@ -5,9 +5,9 @@
 //!
 //! The schema check runs `xmllint` (Debian's `libxml2-utils`); without it
 //! the test says so and passes, except when `CI=true`, where it fails.
-//! `BLESS=1 cargo test --test exports` rewrites the golden files.
+//! `BLESS=1 cargo test --test all exports::` rewrites the golden files.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

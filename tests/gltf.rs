@@ -18,7 +18,7 @@
 //! `/tmp/gv/node_modules` (see `tests/common`). Without it (or without
 //! node) the validation is skipped, except under `CI`, where it fails.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -2,7 +2,7 @@
 //! (see `tests/common`): when a missing tool may be skipped, and when
 //! golden files are rewritten.
 
-mod common;
+use crate::common;
 
 use common::{bless_rule, skip_rule};
 

@@ -16,7 +16,7 @@
 //! `tests/common`): without one, the test that needs it skips outside CI
 //! and fails under CI (`.ci/run tools` installs them).
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
