@@ -163,10 +163,11 @@ fn missing_tools() -> &'static [&'static str] {
 /// notice: the binaries of one run are children of one cargo process, so
 /// the first to create a marker named by that process's id prints it.
 fn first_notice_of_this_run() -> bool {
-    let marker = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
-        "outside-tools-notice-{}",
-        std::os::unix::process::parent_id()
-    ));
+    #[cfg(unix)]
+    let run = std::os::unix::process::parent_id();
+    #[cfg(not(unix))]
+    let run = std::process::id();
+    let marker = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("outside-tools-notice-{run}"));
     // A marker that cannot be made (a read-only target) means printing
     // again, never staying silent.
     !matches!(
