@@ -13,7 +13,7 @@ use std::process::Command;
 use brickwright::pipeline::{self, BuildOptions, BuildOutput, Formats, Silent};
 use brickwright::voxel::Sizing;
 
-mod common;
+use crate::common;
 use common::tool;
 
 fn root() -> PathBuf {

@@ -5,9 +5,9 @@
 //!
 //! The schema check runs `xmllint` (Debian's `libxml2-utils`); without it
 //! the test says so and passes, except when `CI=true`, where it fails.
-//! `BLESS=1 cargo test --test exports` rewrites the golden files.
+//! `BLESS=1 cargo test --test all exports::` rewrites the golden files.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -192,12 +192,7 @@ fn formats_choose_the_files_written() {
 }
 
 fn xmllint() -> Option<PathBuf> {
-    let found = Command::new("xmllint").arg("--version").output().is_ok();
-    if found {
-        return Some(PathBuf::from("xmllint"));
-    }
-    common::missing_tool("xmllint", "apt-get install libxml2-utils");
-    None
+    common::tool("xmllint", "libxml2-utils").then(|| PathBuf::from("xmllint"))
 }
 
 #[test]

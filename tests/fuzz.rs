@@ -14,7 +14,7 @@
 //! checks, which turn silent wrap-arounds into findings):
 //!
 //! ```sh
-//! BRICKWRIGHT_FUZZ_CASES=1000000 cargo test --test fuzz
+//! BRICKWRIGHT_FUZZ_CASES=1000000 cargo test --test all fuzz::
 //! ```
 
 use std::path::{Path, PathBuf};

@@ -14,10 +14,11 @@
 //!   (`tests/tools/validate-gltf.js`).
 //!
 //! The validator is looked up in `$GLTF_VALIDATOR_NODE_PATH`, then
-//! `./node_modules`, then `/tmp/gv/node_modules`. Without it the validation
-//! is skipped with a message, except under `CI=true`, where it fails.
+//! `./node_modules`, then the cache `.ci/run tools` installs it into, then
+//! `/tmp/gv/node_modules` (see `tests/common`). Without it (or without
+//! node) the validation is skipped, except under `CI`, where it fails.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -54,25 +55,10 @@ fn ldr_steps(text: &str) -> Vec<u32> {
     steps
 }
 
-/// The node_modules directory holding `gltf-validator`, if any.
-fn validator_path() -> Option<PathBuf> {
-    let mut candidates = std::env::var_os("GLTF_VALIDATOR_NODE_PATH")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("node_modules"),
-            PathBuf::from("/tmp/gv/node_modules"),
-        ]);
-    candidates.find(|dir| dir.join("gltf-validator").is_dir())
-}
-
 /// Runs the Khronos validator on `files`; panics on any error. Skips (or
-/// fails under `CI=true`) when the validator is not installed.
+/// fails under `CI`) when the validator or node is not installed.
 fn validate(files: &[PathBuf]) {
-    let Some(node_path) = validator_path() else {
-        let msg = "gltf-validator not found: set GLTF_VALIDATOR_NODE_PATH to a node_modules \
-                   directory holding it (npm install gltf-validator@2.0.0-dev.3.10)";
-        common::missing_tool("gltf-validator", msg);
+    let Some(node_path) = common::gltf_validator() else {
         return;
     };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/tools/validate-gltf.js");

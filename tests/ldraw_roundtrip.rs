@@ -1,9 +1,9 @@
 //! LDraw round trips, the golden file, and bad input.
 //!
-//! Run `BLESS=1 cargo test --test ldraw_roundtrip` to rewrite the golden
+//! Run `BLESS=1 cargo test --test all ldraw_roundtrip::` to rewrite the golden
 //! file after an intended change to the output, then review the diff.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

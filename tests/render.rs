@@ -4,10 +4,10 @@
 //! its reference by a small per-channel tolerance (so harmless float
 //! changes pass); past it the test writes the actual image and a diff image
 //! (changed pixels red on a faded copy) into the target directory and says
-//! where. Run `BLESS=1 cargo test --test render` to rewrite the references
+//! where. Run `BLESS=1 cargo test --test all render::` to rewrite the references
 //! after an intended change, then look at them.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -16,7 +16,7 @@ use brickwright::physics::repair::reorder;
 use brickwright::physics::{analyze_steps, Params};
 use serde_json::Value;
 
-mod common;
+use crate::common;
 use common::tool;
 
 /// A gallows: a post one stud square and four bricks high, and an arm

@@ -12,11 +12,11 @@
 //! frame of a small page that waits for the viewer's ready state and logs
 //! it to standard output; ImageMagick's `import` takes the screenshot.
 //!
-//! Chromium, Firefox, Xvfb and ImageMagick are required: without one the
-//! test that needs it fails, unless `BRICKWRIGHT_SKIP_TOOLS=1` asks to skip
-//! (`.ci/run` installs them).
+//! Chromium, Firefox, Xvfb and ImageMagick are outside tools (see
+//! `tests/common`): without one, the test that needs it skips outside CI
+//! and fails under CI (`.ci/run tools` installs them).
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
