@@ -33,6 +33,7 @@ pub mod complex;
 mod cover;
 mod defaults;
 pub mod learn;
+mod numbering;
 mod parse;
 
 pub use complex::{ComplexId, ComplexRule, ComplexVariant, Link, NewPiece, Plates, RulePiece};
@@ -40,6 +41,7 @@ pub use defaults::{
     default_rules, default_rules_text, extended_alphabet, rules_text, COMPLEX_RULES,
     DEFAULT_ALPHABET,
 };
+pub use numbering::{Numbering, RuleNumbers};
 pub use parse::RuleError;
 
 use serde::Serialize;
@@ -147,6 +149,9 @@ pub struct RuleSet {
     complex_variants: Vec<ComplexVariant>,
     /// Where the rules came from, for reports.
     pub source: String,
+    /// The numbering of the file this set was cut down from
+    /// ([`RuleSet::restricted`]); `None`: the set numbers itself.
+    numbered: Option<Box<Numbering>>,
 }
 
 /// The height, in LDU, of one voxel layer for an alphabet: a brick (24)
@@ -185,6 +190,7 @@ impl RuleSet {
             complex: Vec::new(),
             complex_variants: Vec::new(),
             source,
+            numbered: None,
         };
         set.variants = set.generate_variants()?;
         Ok(set)
@@ -238,7 +244,9 @@ impl RuleSet {
             .filter(|r| r.u.iter().chain(&r.v).all(|p| keep(p.part)) && set.fits_layers(r))
             .cloned()
             .collect();
-        set.with_complex(complex)
+        let mut set = set.with_complex(complex)?;
+        set.numbered = Some(Box::new(self.numbering()));
+        Ok(set)
     }
 
     /// The letters of Σ.

@@ -139,10 +139,20 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     };
 
     let pages = booklet.as_ref().map(|b| b.pages);
-    let report = report::compose(opts, &mesh, &model, &settled, hollow, pages, times);
+    let report = report::compose(
+        opts,
+        &setup.rules,
+        &mesh,
+        &model,
+        &settled,
+        hollow,
+        pages,
+        times,
+    );
     progress.stage("writing");
     let report = write::write(
         opts,
+        &setup.rules,
         &settled,
         &pictures,
         rendered.as_ref(),

@@ -26,6 +26,7 @@
 //! piece scored against a fixed set of candidates over it, and bodies are
 //! tracked with a union-find.
 
+mod backward;
 mod complex;
 mod derive;
 mod join;
@@ -33,6 +34,7 @@ mod layout;
 mod merge;
 mod prepare;
 mod rulebook;
+mod written;
 
 use std::time::{Duration, Instant};
 
@@ -44,7 +46,9 @@ use thiserror::Error;
 use crate::assembly::Placement;
 use crate::grammar::{RuleRef, RuleSet};
 use crate::voxel::{Slant, VoxelGrid, Wall};
+pub use backward::{parts as hierarchy_parts, CUT_RATIO};
 pub use prepare::{components, LeftOut, Repairs};
+pub use written::{piece_rules, total_variation, Derivation};
 
 /// The most voxels a model may have: some 400,000 bricks.
 pub const MAX_VOXELS: usize = 2_000_000;
@@ -65,6 +69,29 @@ pub struct SearchOptions {
     /// Build a shell with walls this thick and the inside empty (see
     /// [`crate::voxel::hollow()`]); `None`, the default, builds solid.
     pub hollow: Option<Wall>,
+    /// Which search: the layout (the default) or the paper's backward
+    /// tracing.
+    pub method: Method,
+    /// Backward tracing: the branching factor `b`, from its first value
+    /// at the root to its second as the voxels run out (paper: 10-30
+    /// rising to 100-200). Default (20, 150).
+    pub branching: (u32, u32),
+    /// Backward tracing: the most tree nodes before it gives up. Default
+    /// 1,000,000.
+    pub node_budget: u64,
+    /// Backward tracing: cut the voxels into parts at horizontal planes
+    /// (the paper's hierarchical approach). Default true.
+    pub cut: bool,
+}
+
+/// Which search builds the voxels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum Method {
+    /// The forward layout, course by course ([`build`]'s stages).
+    #[default]
+    Layout,
+    /// The paper's backward tracing (module `backward`).
+    Backward,
 }
 
 impl Default for SearchOptions {
@@ -74,6 +101,10 @@ impl Default for SearchOptions {
             time_budget: Duration::from_secs(300),
             complex_every: 0,
             hollow: None,
+            method: Method::Layout,
+            branching: (20, 150),
+            node_budget: 1_000_000,
+            cut: true,
         }
     }
 }
@@ -94,6 +125,24 @@ impl SearchOptions {
     /// Builds hollow with walls `wall` thick (`None`: solid).
     pub fn with_hollow(mut self, wall: Option<Wall>) -> Self {
         self.hollow = wall;
+        self
+    }
+
+    /// Sets the search method.
+    pub fn with_method(mut self, m: Method) -> Self {
+        self.method = m;
+        self
+    }
+
+    /// Sets the backward tracing's node budget.
+    pub fn with_node_budget(mut self, n: u64) -> Self {
+        self.node_budget = n;
+        self
+    }
+
+    /// Sets the backward tracing's branching factor, first and last.
+    pub fn with_branching(mut self, first: u32, last: u32) -> Self {
+        self.branching = (first, last);
         self
     }
 
@@ -130,6 +179,11 @@ pub struct SearchStats {
     pub complex_applied: u64,
     /// Whether the time budget ran out before every layer was laid.
     pub budget_hit: bool,
+    /// Backward tracing: times it went back up the tree from a node with
+    /// no rule left to try.
+    pub backtracks: u64,
+    /// Backward tracing: parts the voxels were cut into.
+    pub parts: u64,
 }
 
 /// A search that could not produce a build.
@@ -159,6 +213,18 @@ pub enum SearchError {
     /// The rules cannot build the shape.
     #[error("the rules cannot build this shape: {0}")]
     Rules(String),
+    /// The backward tracing found no derivation.
+    #[error("the backward search found no derivation: {why} ({nodes} nodes, {backtracks} backtracks, {secs:.1} s)")]
+    Backward {
+        /// Why it stopped.
+        why: String,
+        /// Tree nodes made.
+        nodes: u64,
+        /// Times it went back up the tree.
+        backtracks: u64,
+        /// Seconds spent.
+        secs: f64,
+    },
 }
 
 /// What a piece is attached to in the derivation.
@@ -296,6 +362,9 @@ pub fn build_guided(
         fixed = h.shell;
         h.emptied
     });
+    if opts.method == Method::Backward {
+        return backward::build(fixed, repairs, emptied, rules, opts, started);
+    }
 
     let mut layout = layout::Layout::new(rules, &fixed, guide.surface, guide.slant);
     layout.repairs = repairs;
