@@ -177,7 +177,10 @@ fn fixture_voxels(name: &str, studs: u32, rules: &RuleSet) -> VoxelGrid {
 fn the_house_fixture_is_traced_backward_whole_and_verifies() {
     let rules = bricks();
     let grid = fixture_voxels("house.obj", 8, &rules);
-    let out = search::build(&grid, &rules, &backward(1)).unwrap();
+    let opts = backward(1)
+        .with_node_budget(300_000)
+        .with_time_budget(std::time::Duration::from_secs(120));
+    let out = search::build(&grid, &rules, &opts).unwrap();
     let asm = Assembly::from_order(&search::placements(&out), rules.layer_ldu(), Color::RED);
     let report = verify(&asm, Some(&out.voxels));
     assert!(report.is_ok(), "{report}");
@@ -188,4 +191,49 @@ fn the_house_fixture_is_traced_backward_whole_and_verifies() {
     assert!(out.stats.parts >= 1);
     let d = Derivation::of(&out.order, &rules);
     assert_eq!(d.forward.len(), out.order.len());
+}
+
+/// The share of rule `n` in the derivations of `shape` over seeds 1 to 5.
+fn share(rules: &RuleSet, shape: &VoxelGrid, method: Method, n: u32) -> f64 {
+    let (mut hit, mut all) = (0u32, 0usize);
+    for seed in 1..=5 {
+        let opts = SearchOptions::default().with_seed(seed).with_method(method);
+        let out = search::build(shape, rules, &opts).unwrap();
+        let d = Derivation::of(&out.order, rules);
+        hit += d.uses.get(&n).copied().unwrap_or(0);
+        all += d.forward.len();
+    }
+    f64::from(hit) / all as f64
+}
+
+#[test]
+fn a_heavy_rule_is_used_more_by_both_searches() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("rules/figure2.rules"),
+    )
+    .unwrap();
+    // Rule 5 (a 1x2 half under a 1x2, down) made 200 times as heavy.
+    let heavy = text.replace(
+        "rule 3004   3004   r0   down    1   0  5 ",
+        "rule 3004   3004   r0   down    1   0  1000 ",
+    );
+    assert_ne!(heavy, text);
+    let plain = RuleSet::parse(&text, "figure2.rules".as_ref()).unwrap();
+    let heavy = RuleSet::parse(&heavy, "heavy.rules".as_ref()).unwrap();
+    let shape = figure5_shape();
+    let before = share(&plain, &shape, Method::Backward, 5);
+    let after = share(&heavy, &shape, Method::Backward, 5);
+    assert!(after > before, "backward: rule 5's share {before:.3} -> {after:.3}");
+    // The layout lays pieces course by course and derives them upward; a
+    // heavy rule there wins among joints of equal fit. Rule 4 (a 1x2 half
+    // over a 1x2) made heavy is the upward joint it can prefer.
+    let heavy4 = text.replace(
+        "rule 3004   3004   r0   up      1   0  6 ",
+        "rule 3004   3004   r0   up      1   0  1000 ",
+    );
+    assert_ne!(heavy4, text);
+    let heavy4 = RuleSet::parse(&heavy4, "heavy4.rules".as_ref()).unwrap();
+    let before = share(&plain, &shape, Method::Layout, 4);
+    let after = share(&heavy4, &shape, Method::Layout, 4);
+    assert!(after > before, "layout: rule 4's share {before:.3} -> {after:.3}");
 }

@@ -10,9 +10,11 @@
 //! - a **complex rule** `u -> v` adds several pieces, in order, where
 //!   several pieces are in place (module [`complex`]; paper, Figure 4).
 //!
-//! Each rule carries a weight: how often people use it. The search samples
-//! rules from the categorical distribution of these weights, so common,
-//! sturdy joints are tried first.
+//! Each rule carries a weight: how often people use it. The layout (the
+//! default search) adds, among pieces of equal fit, the one whose joint the
+//! heaviest rule makes; the backward search (`--search backward`) draws the
+//! rules it tries at each node from the categorical distribution of the
+//! weights, so common, sturdy joints are tried first.
 //!
 //! Rules are read from human-readable files ([`RuleSet::parse`]); the file
 //! gives each rule once, with `A` unturned, and the loader generates the

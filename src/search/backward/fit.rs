@@ -26,9 +26,11 @@ fn bx(min: Cell, sx: i32, sy: i32, sz: i32) -> CellBox {
     CellBox { min, sx, sy, sz }
 }
 
-/// Whether the box `b` can travel from its place out of the grid through
-/// cells `solid` leaves empty.
-pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid) -> bool {
+/// Whether the box `b` can be pressed into its place from above
+/// (`from_above`, a piece pressed onto studs below it) or from below,
+/// through cells `solid` leaves empty: the cell layer beside it that way
+/// is empty, and from there the box travels out of the grid.
+pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> bool {
     let clear = |at: &CellBox| !solid.any_set(at);
     let (nx, ny, nz) = solid.dims();
     // Straight up or straight down.
@@ -40,8 +42,19 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid) -> bool {
             (to.min(nz) - from.max(0)).max(0),
         )
     };
-    if clear(&column(b.min.z + b.sz, nz)) || clear(&column(0, b.min.z)) {
+    let straight = if from_above {
+        column(b.min.z + b.sz, nz)
+    } else {
+        column(0, b.min.z)
+    };
+    if clear(&straight) {
         return true;
+    }
+    // The box one cell that way must be free: it is pressed on last.
+    let dz = if from_above { 1 } else { -1 };
+    let first = bx(b.min.offset(0, 0, dz), b.sx, b.sy, b.sz);
+    if !clear(&first) {
+        return false;
     }
     let out = |m: Cell| {
         m.x + b.sx <= 0 || m.y + b.sy <= 0 || m.z + b.sz <= 0 || m.x >= nx || m.y >= ny || m.z >= nz
@@ -49,7 +62,8 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid) -> bool {
     let mut seen: HashSet<Cell> = HashSet::new();
     let mut queue: VecDeque<Cell> = VecDeque::new();
     seen.insert(b.min);
-    queue.push_back(b.min);
+    seen.insert(first.min);
+    queue.push_back(first.min);
     while let Some(m) = queue.pop_front() {
         if seen.len() > MAX_VISITED {
             return false;
@@ -95,7 +109,12 @@ mod tests {
         let b = bx(Cell::new(2, 2, 2), 1, 1, 1);
         // A roof above and a floor below: it slides out to the side.
         let g = grid(&[(2, 2, 3), (2, 2, 1)]);
-        assert!(placeable(&b, &g));
+        assert!(!placeable(&b, &g, true));
+        let g = grid(&[(2, 2, 4), (2, 2, 1)]);
+        assert!(placeable(&b, &g, true));
+        assert!(!placeable(&b, &g, false));
+        let g = grid(&[(2, 2, 3), (2, 2, 0)]);
+        assert!(placeable(&b, &g, false));
         // Walled in on all six sides: enclosed.
         let g = grid(&[
             (2, 2, 3),
@@ -105,7 +124,7 @@ mod tests {
             (2, 1, 2),
             (2, 3, 2),
         ]);
-        assert!(!placeable(&b, &g));
+        assert!(!placeable(&b, &g, true));
         // A 2-wide piece does not pass a 1-wide gap.
         let wide = bx(Cell::new(1, 2, 2), 2, 1, 1);
         let mut g = VoxelGrid::new(5, 5, 5);
@@ -120,7 +139,7 @@ mod tests {
                 }
             }
         }
-        assert!(!placeable(&wide, &g));
-        assert!(placeable(&bx(Cell::new(2, 2, 2), 1, 1, 1), &g));
+        assert!(!placeable(&wide, &g, true));
+        assert!(placeable(&bx(Cell::new(2, 2, 2), 1, 1, 1), &g, true));
     }
 }

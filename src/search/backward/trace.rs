@@ -17,12 +17,14 @@
 //! `b_min` to `b_max` as fewer voxels are left. Once every `complex_every`
 //! nodes, a complex rule picked with equal probability is tried first. A
 //! rule labelled `up` is matched scanning from the top of the grid down, a
-//! `down` rule from the bottom up, and the first match the scan finds is
-//! the rule's child. A match must join the pieces matched so far (its new
-//! piece is a matched piece, or stud-connects to one), except the first,
+//! `down` rule from the bottom up, and each match the scan finds is
+//! a child, the first match first. A match must join the pieces matched so
+//! far (its new piece or its anchor is a matched piece, or stud-connects
+//! to one), except the first,
 //! and its new piece must be able to reach its place past what is built
 //! before it ([`super::fit`]). A node whose voxels fall apart, or that was
-//! met before and failed, is cut off; a node with no child left is
+//! met before and failed with every rule tried, is cut off; a node with
+//! no child left is
 //! backtracked from.
 
 use std::collections::{HashMap, HashSet};
@@ -88,12 +90,18 @@ struct Frame {
     /// `Err(variant)` a complex one.
     tries: Vec<Result<u32, u32>>,
     next: usize,
+    /// Where the scan of the rule being tried goes on: each match of a
+    /// rule, in scan order, is a child.
+    cursor: usize,
     /// (B, A) pairs already tried here.
     tried: HashSet<(Placement, Placement)>,
     /// Where each shape of new piece may be taken away at this node.
     spots: HashMap<(PartKind, Rot), Vec<Placement>>,
     /// The change that made this node from its parent.
     change: Option<Change>,
+    /// Whether every rule that could match is among `tries` (`b` was no
+    /// smaller than their number): only then is a failure here final.
+    complete: bool,
 }
 
 /// A part being traced.
@@ -198,17 +206,25 @@ impl<'a> Trace<'a> {
             let mut child = None;
             while top.next < top.tries.len() && child.is_none() {
                 let t = top.tries[top.next];
-                top.next += 1;
                 let found = match t {
-                    Ok(v) => self.match_basic(v, top),
+                    Ok(v) => self.match_basic(v, top, top.cursor),
                     Err(v) => {
-                        count.complex_tried += 1;
-                        self.match_complex(v, top)
+                        if top.cursor == 0 {
+                            count.complex_tried += 1;
+                        }
+                        self.match_complex(v, top, top.cursor)
                     }
                 };
-                if let Some(c) = found {
-                    top.tried.insert((c.taken[0].0, c.taken[0].1));
-                    child = Some(c);
+                match found {
+                    Some((c, at)) => {
+                        top.cursor = at + 1;
+                        top.tried.insert((c.taken[0].0, c.taken[0].1));
+                        child = Some(c);
+                    }
+                    None => {
+                        top.next += 1;
+                        top.cursor = 0;
+                    }
                 }
             }
             match child {
@@ -229,7 +245,11 @@ impl<'a> Trace<'a> {
                 None => {
                     // Every rule tried: back up.
                     let done = stack.pop().expect("a frame is on the stack");
-                    self.failed.insert(self.hash);
+                    // A node that tried only `b` of its rules may succeed
+                    // with another draw when it is met again.
+                    if done.complete {
+                        self.failed.insert(self.hash);
+                    }
                     if let Some(c) = done.change {
                         count.backtracks += 1;
                         self.undo(&c);
@@ -252,7 +272,7 @@ impl<'a> Trace<'a> {
             .rules
             .variants()
             .iter()
-            .map(|v| (v.added, v.added_rot))
+            .flat_map(|v| [(v.added, v.added_rot), (v.anchor, v.anchor_rot)])
             .chain(
                 self.rules
                     .complex_variants()
@@ -267,20 +287,24 @@ impl<'a> Trace<'a> {
             .map(|(p, r)| ((p, r), self.spots(p, r)))
             .filter(|(_, s)| !s.is_empty())
             .collect();
-        let fits = |k: &(PartKind, Rot)| spots.contains_key(k);
+        let fits = |v: &crate::grammar::Variant| {
+            spots.contains_key(&(v.added, v.added_rot))
+                || spots.contains_key(&(v.anchor, v.anchor_rot))
+        };
         // Weighted sampling without replacement: the largest u^(1/w).
         let mut keyed: Vec<(f64, u32)> = self
             .rules
             .variants()
             .iter()
             .enumerate()
-            .filter(|(_, v)| v.weight > 0.0 && fits(&(v.added, v.added_rot)))
+            .filter(|(_, v)| v.weight > 0.0 && fits(v))
             .map(|(i, v)| {
                 let u: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
                 (u.ln() / v.weight, i as u32)
             })
             .collect();
         keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let complete = keyed.len() <= b.max(1);
         keyed.truncate(b.max(1));
         let mut tries: Vec<Result<u32, u32>> = keyed.into_iter().map(|(_, i)| Ok(i)).collect();
         let nc = self.rules.complex_variants().len();
@@ -291,9 +315,11 @@ impl<'a> Trace<'a> {
         Frame {
             tries,
             next: 0,
+            cursor: 0,
             tried: HashSet::new(),
             spots,
             change,
+            complete,
         }
     }
 
@@ -365,26 +391,44 @@ impl<'a> Trace<'a> {
     /// Whether a piece taken away at `b` could have been put in place:
     /// what is left of the part besides `b`, and the parts below, leave it
     /// a way in.
-    fn can_place(&self, b: &Body, also_gone: &[Body]) -> bool {
+    fn can_place(&self, b: &Body, also_gone: &[Body], from_above: bool) -> bool {
         let mut solid = self.built.clone();
         solid.set_body(b, false);
         for g in also_gone {
             solid.set_body(g, false);
         }
-        placeable(&b.bbox, &solid)
+        placeable(&b.bbox, &solid, from_above)
     }
 
     /// The first match of basic variant `v` in its scan direction.
-    fn match_basic(&self, v: u32, node: &Frame) -> Option<Change> {
+    fn match_basic(&self, v: u32, node: &Frame, from: usize) -> Option<(Change, usize)> {
         let var = self.rules.variants()[v as usize];
-        let spots = node.spots.get(&(var.added, var.added_rot))?;
+        let (ox, oy, oz) = var.offset;
+        // The new piece where it joins what is matched, or where its
+        // anchor does.
+        let mut spots: Vec<Placement> = node
+            .spots
+            .get(&(var.added, var.added_rot))
+            .into_iter()
+            .flatten()
+            .copied()
+            .chain(
+                node.spots
+                    .get(&(var.anchor, var.anchor_rot))
+                    .into_iter()
+                    .flatten()
+                    .map(|a| Placement::new(var.added, a.origin.offset(ox, oy, oz), var.added_rot)),
+            )
+            .collect();
+        spots.sort_by_key(|p| (p.origin.z, p.origin.y, p.origin.x));
+        spots.dedup();
         let tried = &node.tried;
-        let order: Box<dyn Iterator<Item = &Placement>> = match var.dir {
-            Dir::Up => Box::new(spots.iter().rev()),
-            Dir::Down => Box::new(spots.iter()),
-        };
-        for b in order {
-            let (ox, oy, oz) = var.offset;
+        let n = spots.len();
+        for k in from..n {
+            let b = match var.dir {
+                Dir::Up => &spots[n - 1 - k],
+                Dir::Down => &spots[k],
+            };
             let at = b.origin.offset(-ox, -oy, -oz);
             let a = Placement::new(var.anchor, at, var.anchor_rot);
             if tried.contains(&(*b, a)) {
@@ -396,30 +440,34 @@ impl<'a> Trace<'a> {
             if !a_pending && !self.free(&ab) {
                 continue;
             }
+            if !self.is_pending(b) && !self.free(&bb) {
+                continue;
+            }
             // The rule's joint, as the grid has it.
             let joined = match var.dir {
                 Dir::Up => ab.holds(&bb),
                 Dir::Down => bb.holds(&ab),
             };
-            if !joined || !self.can_place(&bb, &[]) {
+            if !joined || !self.can_place(&bb, &[], var.dir == Dir::Up) {
                 continue;
             }
-            return Some(Change {
+            let c = Change {
                 rule: RuleRef::Basic(var.rule),
                 taken: vec![(*b, a)],
                 new_pending: if a_pending { vec![] } else { vec![a] },
-            });
+            };
+            return Some((c, k));
         }
         None
     }
 
     /// The first match of complex variant `v`: its new pieces free or
     /// pending, its `u` pieces pending or free, joined to what is matched.
-    fn match_complex(&self, v: u32, node: &Frame) -> Option<Change> {
+    fn match_complex(&self, v: u32, node: &Frame, from: usize) -> Option<(Change, usize)> {
         let var = &self.rules.complex_variants()[v as usize];
         let first = var.v.first()?;
         let spots = node.spots.get(&(first.piece.part, first.piece.rot))?;
-        for s in spots.iter().rev() {
+        for (k, s) in spots.iter().rev().enumerate().skip(from) {
             let at = first.piece.at;
             let origin = s.origin.offset(-at.x, -at.y, -at.z);
             let place = |p: &crate::grammar::complex::VariantPiece| {
@@ -450,7 +498,13 @@ impl<'a> Trace<'a> {
             // Each new piece goes in past the ones before it and what is
             // left; the later ones are not there yet.
             let bodies: Vec<Body> = news.iter().map(|p| self.body(p)).collect();
-            let placeable = (0..bodies.len()).all(|k| self.can_place(&bodies[k], &bodies[k + 1..]));
+            let placeable = (0..bodies.len()).all(|i| {
+                let anchor = match var.v[i].anchor {
+                    Link::U(j) => self.body(&olds[j]),
+                    Link::V(j) => bodies[j],
+                };
+                self.can_place(&bodies[i], &bodies[i + 1..], anchor.holds(&bodies[i]))
+            });
             if !placeable {
                 continue;
             }
@@ -471,11 +525,12 @@ impl<'a> Trace<'a> {
                 .filter(|p| !self.is_pending(p))
                 .copied()
                 .collect();
-            return Some(Change {
+            let c = Change {
                 rule: RuleRef::Complex(var.rule),
                 taken,
                 new_pending,
-            });
+            };
+            return Some((c, k));
         }
         None
     }
