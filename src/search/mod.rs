@@ -345,6 +345,11 @@ pub fn build_guided(
     let started = Instant::now();
     let deadline = started + opts.time_budget;
     let (mut fixed, mut repairs) = prepare::repair_islands(voxels);
+    // The backward search traces the voxels as they are (islands joined
+    // only): thickening sheets would add voxels no rule may need.
+    if opts.method == Method::Backward {
+        return backward::build(fixed, repairs, None, rules, opts, started);
+    }
     // A course is a brick's height in layers; a sheet one course thick is
     // pieces side by side that cannot hold together, except plates, which
     // two layers laminate.
@@ -362,9 +367,6 @@ pub fn build_guided(
         fixed = h.shell;
         h.emptied
     });
-    if opts.method == Method::Backward {
-        return backward::build(fixed, repairs, emptied, rules, opts, started);
-    }
 
     let mut layout = layout::Layout::new(rules, &fixed, guide.surface, guide.slant);
     layout.repairs = repairs;

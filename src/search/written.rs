@@ -24,9 +24,11 @@
 //! }
 //! let out = build(&grid, &rules, &SearchOptions::default()).unwrap();
 //! let d = Derivation::of(&out.order, &rules);
-//! // A starting rule (0) puts the first 1x2 down, rule 1 adds the other.
-//! assert_eq!(d.forward, [0, 1]);
-//! assert_eq!(d.backward, [1, 0]);
+//! // A starting rule (rule 0) puts the first 1x2 down; backward, it comes
+//! // last.
+//! assert_eq!(d.forward[0], 0);
+//! assert_eq!(d.backward.last(), Some(&0));
+//! assert_eq!(d.forward.iter().rev().copied().collect::<Vec<_>>(), d.backward);
 //! ```
 
 use std::collections::{BTreeMap, HashMap};

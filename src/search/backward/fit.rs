@@ -130,7 +130,7 @@ mod tests {
         let mut g = VoxelGrid::new(5, 5, 5);
         for x in 0..5 {
             for y in 0..5 {
-                if !(y == 2 && x >= 1 && x <= 2) {
+                if !(y == 2 && (1..=2).contains(&x)) {
                     g.set(Cell::new(x, y, 2), true);
                 }
                 g.set(Cell::new(x, y, 1), true);

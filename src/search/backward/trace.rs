@@ -197,7 +197,7 @@ impl<'a> Trace<'a> {
             if count.nodes >= self.tuning.node_budget {
                 return Err(Stop::Nodes);
             }
-            if count.nodes % 64 == 0 && Instant::now() >= self.tuning.deadline {
+            if count.nodes.is_multiple_of(64) && Instant::now() >= self.tuning.deadline {
                 return Err(Stop::Time);
             }
             let Some(top) = stack.last_mut() else {
@@ -308,7 +308,7 @@ impl<'a> Trace<'a> {
         keyed.truncate(b.max(1));
         let mut tries: Vec<Result<u32, u32>> = keyed.into_iter().map(|(_, i)| Ok(i)).collect();
         let nc = self.rules.complex_variants().len();
-        if t.complex_every > 0 && nc > 0 && count.nodes % u64::from(t.complex_every) == 0 {
+        if t.complex_every > 0 && nc > 0 && count.nodes.is_multiple_of(u64::from(t.complex_every)) {
             let pick = rng.gen_range(0..nc) as u32;
             tries.insert(0, Err(pick));
         }
