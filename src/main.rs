@@ -10,7 +10,7 @@ use brickwright::assembly::verify::verify;
 use brickwright::grammar::learn::learn;
 use brickwright::grammar::{extended_alphabet, rules_text, DEFAULT_ALPHABET};
 use brickwright::pipeline::{self, Progress, Silent};
-use brickwright::terminal::{escape_controls, escape_lines};
+use brickwright::terminal::{escape_lines, escape_message};
 
 /// `println!` that ends the program quietly when standard output has been
 /// closed (`brickwright verify x.ldr | head -1`) instead of panicking; the
@@ -47,7 +47,7 @@ fn run_build(a: BuildArgs) -> Result<()> {
     let out = pipeline::build(&opts, progress)?;
     // Warnings go to standard error, with --quiet too.
     for w in out.report.warnings() {
-        eprintln!("warning: {}", escape_controls(&w));
+        eprintln!("warning: {}", escape_message(&w));
     }
     if !quiet {
         print::build_summary(&out.report, &opts.out_dir);
@@ -58,6 +58,12 @@ fn run_build(a: BuildArgs) -> Result<()> {
 fn run_verify(file: PathBuf, stability: Option<GroundArg>) -> Result<bool> {
     let model = brickwright::ldraw::read_ldr(&file)?;
     let asm = brickwright::ldraw::to_assembly(&model)?;
+    if asm.pieces.is_empty() {
+        // Nothing to check is not a sound build.
+        outln!("{}: 1 problem", file.display());
+        outln!("  - it has no pieces: no line places a part (LDraw line type 1)");
+        return Ok(false);
+    }
     let report = verify(&asm, None);
     let sound = report.is_ok();
     if sound {
@@ -122,6 +128,12 @@ fn run_learn(a: LearnArgs) -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C: no half-written outputs or temporary files left behind (a
+    // commit under way is let finish), then the shell's code for SIGINT.
+    let _ = ctrlc::set_handler(|| {
+        brickwright::fsutil::interrupted();
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Build(a) => run_build(a).map(|()| true),
@@ -143,8 +155,8 @@ fn main() -> ExitCode {
                 Some(pipeline::BuildError::Unstable { .. }) => 1,
                 _ => 2,
             };
-            // One line: the error, then any cause its message does not
-            // already say.
+            // The error, then any cause its message does not already say;
+            // a message of several lines keeps them, indented.
             let mut line = e.to_string();
             for cause in e.chain().skip(1) {
                 let c = cause.to_string();
@@ -153,7 +165,7 @@ fn main() -> ExitCode {
                     line.push_str(&c);
                 }
             }
-            eprintln!("error: {}", escape_controls(&line));
+            eprintln!("error: {}", escape_message(&line));
             ExitCode::from(code)
         }
     }

@@ -40,10 +40,38 @@ pub fn escape_lines(s: &str) -> String {
     }
     out.join("\n")
 }
+/// A message of one or more lines (a warning, an error chain) for a line
+/// that starts with a label such as `error: `: every line escaped as in
+/// [`escape_controls`], its real line breaks kept, and each line after the
+/// first indented by two spaces, so no part of the message (not even a
+/// hostile name holding a line break) can pass for a line of its own.
+/// Trailing line breaks are dropped.
+///
+/// ```
+/// use brickwright::terminal::escape_message;
+///
+/// assert_eq!(escape_message("failed:\n 2 overlaps\n"), "failed:\n   2 overlaps");
+/// ```
+pub fn escape_message(s: &str) -> String {
+    s.trim_end_matches(['\n', '\r'])
+        .split('\n')
+        .map(|l| escape_controls(l.strip_suffix('\r').unwrap_or(l)))
+        .collect::<Vec<_>>()
+        .join("\n  ")
+}
 
 #[cfg(test)]
 mod tests {
-    use super::{escape_controls, escape_lines};
+    use super::{escape_controls, escape_lines, escape_message};
+
+    #[test]
+    fn messages_keep_real_line_breaks_indented() {
+        // Was one line with a literal `\u{a}` (issue 30, finding 13).
+        let shown = escape_message("internal error (3 problems:\n a\r\n b\u{1b}[2J)\n\n");
+        assert_eq!(shown, "internal error (3 problems:\n   a\n   b\\u{1b}[2J)");
+        assert!(!shown.contains("\\u{a}"), "{shown}");
+        assert_eq!(escape_message("one line"), "one line");
+    }
 
     #[test]
     fn lines_keep_their_breaks() {

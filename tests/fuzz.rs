@@ -1,5 +1,6 @@
-//! Fuzzing every parser of untrusted input on stable Rust: OBJ, STL,
-//! glTF/GLB, LDraw, rule files and booklet templates.
+//! Fuzzing every parser of untrusted input on stable Rust: OBJ (with its
+//! material library and textures), STL, glTF/GLB, LDraw, rule files and
+//! booklet templates.
 //!
 //! Each parser gets inputs made by mutating small valid files the test
 //! writes itself (bytes flipped, cut, duplicated, and format words such as
@@ -178,6 +179,37 @@ fn obj_seeds() -> Vec<Vec<u8>> {
     vec![s.into_bytes(), quad.as_bytes().to_vec()]
 }
 
+fn mtl_seeds() -> Vec<Vec<u8>> {
+    let full = "# lib\nnewmtl red\nKa 0 0 0\nKd 1 0 0\nKs 0.5 0.5 0.5\nNs 10\nd 1\nillum 2\n\
+                newmtl tex\nKd 1 1 1\nmap_Kd -s 1 1 1 tex.png\nmap_Bump n.png\n";
+    vec![full.as_bytes().to_vec(), b"newmtl a\nKd 0.5\n".to_vec()]
+}
+
+/// A small PNG: 4 x 4 texels, two colours.
+fn png_seed() -> Vec<u8> {
+    let img = image::RgbImage::from_fn(4, 4, |x, _| {
+        image::Rgb(if x < 2 { [200, 0, 0] } else { [0, 0, 200] })
+    });
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// A textured square using both materials of [`mtl_seeds`].
+const TEXTURED_OBJ: &str = "mtllib a.mtl\nmtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+    vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3\nusemtl red\nf 1/1 3/3 4/4\n";
+
+/// Loads [`TEXTURED_OBJ`] from a fresh folder holding `mtl` as its
+/// material library and `png` as its texture.
+fn load_textured(mtl: &[u8], png: &[u8]) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.mtl"), mtl).unwrap();
+    std::fs::write(dir.path().join("tex.png"), png).unwrap();
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, TEXTURED_OBJ).unwrap();
+    let _ = mesh::load(&path);
+}
+
 fn stl_seeds() -> Vec<Vec<u8>> {
     let (v, t) = cube();
     let mut bin = vec![0u8; 80];
@@ -306,6 +338,27 @@ proptest! {
             "\nmtllib /etc/passwd", "\nf 1 2 3 4 5 6", "\nf -9 -8 -7", "\\\n", "#"]);
         let b = bytes(&i, &obj_seeds(), &words);
         let _ = mesh::parse(Path::new("fuzz.obj"), &b);
+    }
+
+    #[test]
+    fn material_libraries_never_panic(i in input()) {
+        // `Kd 1 1`, `Ks 1` and a bare `Kd` made tobj's own reader panic.
+        let words = dict(&["\nnewmtl", "\nnewmtl ", "\nKd", "\nKd 1 1", "\nKs 1", " nan",
+            " inf", " -1e39", "\nmap_Kd", "\nmap_Kd ../x.png", "\nmap_Kd /dev/zero",
+            "\nmap_Kd tex.png", " -o 1 1", "#", "\t", "\r\n"]);
+        let b = bytes(&i, &mtl_seeds(), &words);
+        let lib = mesh::mtl::parse(&String::from_utf8_lossy(&b));
+        prop_assert!(lib.materials.iter().all(|m| !m.name.is_empty()));
+        prop_assert!(lib.materials.iter().flat_map(|m| m.kd).flatten().all(|c| (0.0..=1.0).contains(&c)));
+        load_textured(&b, &png_seed());
+    }
+
+    #[test]
+    fn textures_never_panic(i in input()) {
+        let words = dict(&["\u{89}PNG\r\n\u{1a}\n", "IHDR", "IDAT", "IEND", "\u{ff}\u{d8}\u{ff}",
+            "\u{0}\u{0}\u{ff}\u{ff}", "\u{7f}\u{ff}\u{ff}\u{ff}"]);
+        let b = bytes(&i, &[png_seed()], &words);
+        load_textured(&mtl_seeds()[0], &b);
     }
 
     #[test]

@@ -474,3 +474,7 @@ fn every_subcommand_knows_the_version_and_shows_examples() {
     let o = brickwright(tmp.path(), &["--help"]);
     assert!(text(&o.stdout).contains("Exit codes:"), "{}", describe(&o));
 }
+
+/// Round two of the probe (issue 30), in its own file.
+#[path = "hostile/round_two.rs"]
+mod round_two;

@@ -6,6 +6,7 @@
 
 pub mod metrics;
 pub mod order;
+pub mod stairs;
 pub mod verify;
 
 use serde::Serialize;

@@ -306,7 +306,11 @@ fn check_overlaps(boxes: &[CellBox]) -> Vec<Failure> {
 /// tubes; the physics stage also uses the others (compression only).
 ///
 /// Found through the cells under each piece, so the time grows with the
-/// pieces' footprints, not with the square of the pieces in a layer.
+/// pieces' footprints, not with the square of the pieces in a layer. A
+/// cell remembers the first `MAX_OVERLAPS_PER_PIECE` (8) pieces whose bottom
+/// covers it: in a build without overlaps there is one at most, and a file
+/// stacking thousands of copies on one spot (each an overlap already) gives
+/// a bounded number of pairs instead of the square of the copies.
 pub fn stacked_pairs(bodies: &[Body]) -> Vec<(usize, usize)> {
     // The pieces whose bounding box's bottom layer covers each cell.
     let mut bottoms: HashMap<Cell, Vec<usize>> = HashMap::new();
@@ -314,10 +318,10 @@ pub fn stacked_pairs(bodies: &[Body]) -> Vec<(usize, usize)> {
         let bx = &b.bbox;
         for y in bx.min.y..bx.min.y + bx.sy {
             for x in bx.min.x..bx.min.x + bx.sx {
-                bottoms
-                    .entry(Cell::new(x, y, bx.min.z))
-                    .or_default()
-                    .push(i);
+                let here = bottoms.entry(Cell::new(x, y, bx.min.z)).or_default();
+                if here.len() < MAX_OVERLAPS_PER_PIECE {
+                    here.push(i);
+                }
             }
         }
     }
@@ -544,6 +548,16 @@ fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
     }
     shut.reverse();
     shut
+}
+
+/// Whether a piece with box `b` can be put in place after the pieces with
+/// boxes `earlier` (the placeability rule of the module docs, alone).
+pub fn placeable_after(earlier: &[CellBox], b: &CellBox) -> bool {
+    let mut occ = Occupied::default();
+    for e in earlier {
+        occ.add(e);
+    }
+    !occ.any_in(b) && placeable(b, &occ)
 }
 
 /// The box `b` moved to minimum corner `min`.

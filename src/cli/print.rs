@@ -82,6 +82,15 @@ pub fn build_summary(r: &BuildReport, out_dir: &Path) {
             q.extent_studs,
             q.requested_studs.map_or("by height".to_string(), |n| n.to_string())
         );
+    if r.options.slopes && q.stair_edges.top + q.stair_edges.underside > 0 {
+        outln!(
+            "  stair edges: {} of {} on top capped with slopes, {} of {} underneath with inverted slopes",
+            q.stair_edges_capped.top,
+            q.stair_edges.top,
+            q.stair_edges_capped.underside,
+            q.stair_edges.underside
+        );
+    }
     outln!(
             "  seams: {} of {} vertical seams continue into the course above ({:.0}%; lower is stronger)",
             r.seams.continued,

@@ -365,17 +365,41 @@ pub fn write_html<W: Write + ?Sized>(
 ) -> io::Result<()> {
     let model = ViewerModel::of(assembly, opts);
     let json = serde_json::to_string(&model).map_err(io::Error::other)?;
-    let page = PAGE
-        .replace("{{TITLE}}", &escape_html(&opts.name))
-        .replace("{{STYLE}}", STYLE.trim_end())
-        .replace("{{SCRIPT}}", SCRIPT.trim_end());
-    // The model goes in last, so that nothing in it is taken for a slot.
-    let (head, tail) = page
-        .split_once("{{MODEL}}")
-        .ok_or_else(|| io::Error::other("viewer page template has no {{MODEL}} slot"))?;
-    w.write_all(head.as_bytes())?;
-    w.write_all(escape_script(&json).as_bytes())?;
-    w.write_all(tail.as_bytes())
+    let title = escape_html(&opts.name);
+    let model = escape_script(&json);
+    // One pass over the template: a value written into a slot is never
+    // read again, so a model named `{{MODEL}}.obj` stays a title.
+    fill_slots(w, PAGE, |slot| match slot {
+        "TITLE" => Some(title.as_str()),
+        "STYLE" => Some(STYLE.trim_end()),
+        "SCRIPT" => Some(SCRIPT.trim_end()),
+        "MODEL" => Some(model.as_str()),
+        _ => None,
+    })
+}
+
+/// Writes `template` to `w` with each `{{NAME}}` slot replaced by
+/// `value(NAME)`, in a single pass; an unknown or unclosed slot is an error.
+fn fill_slots<'a, W: Write + ?Sized>(
+    w: &mut W,
+    template: &str,
+    value: impl Fn(&str) -> Option<&'a str>,
+) -> io::Result<()> {
+    let mut rest = template;
+    while let Some(at) = rest.find("{{") {
+        w.write_all(&rest.as_bytes()[..at])?;
+        let after = &rest[at + 2..];
+        let end = after
+            .find("}}")
+            .ok_or_else(|| io::Error::other("viewer page template has an unclosed slot"))?;
+        let name = &after[..end];
+        let v = value(name).ok_or_else(|| {
+            io::Error::other(format!("viewer page template has an unknown slot {name:?}"))
+        })?;
+        w.write_all(v.as_bytes())?;
+        rest = &after[end + 2..];
+    }
+    w.write_all(rest.as_bytes())
 }
 
 /// Text for HTML content and attribute values.

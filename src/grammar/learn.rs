@@ -56,7 +56,7 @@
 //! assert!(learned.to_rules_text().contains("rule 3001   3001   r0   up      0  -1  2\n"));
 //! ```
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -66,7 +66,7 @@ use thiserror::Error;
 use super::{Dir, Rule, RuleError, RuleSet, StartRule, DEFAULT_ALPHABET};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Body, Rot};
+use crate::geom::{Body, Cell, Rot};
 use crate::ldraw::{layer_ldu_of, read_ldr, to_placement, LdrError, LdrModel};
 
 /// The paper's figures for its collected data (section 5), shown beside
@@ -463,12 +463,36 @@ fn count_build(
     report: &mut LearnReport,
 ) {
     let mut placed: Vec<(usize, Placement, Body)> = Vec::with_capacity(pieces.len());
+    // Earlier pieces by the cells of their top and bottom layers: only a
+    // piece whose top meets this one's bottom, or whose bottom meets its
+    // top, over a shared cell can hold it or be held. Each cell remembers
+    // the first few pieces (one, in a build without overlaps), so a file
+    // stacking thousands of copies on one spot is not paired copy by copy.
+    let mut tops: HashMap<Cell, Vec<usize>> = HashMap::new();
+    let mut bottoms: HashMap<Cell, Vec<usize>> = HashMap::new();
+    let mut near: Vec<usize> = Vec::new();
     for &(instance, mut piece) in pieces {
         debug_assert_eq!(piece.origin.z % layer_ldu, 0);
         piece.origin.z /= layer_ldu;
         let body = piece.body(layer_ldu);
+        let bx = body.bbox;
+        let (bottom, top) = (bx.min.z, bx.min.z + bx.sz);
+        let footprint = |z: i32| {
+            (bx.min.y..bx.min.y + bx.sy)
+                .flat_map(move |y| (bx.min.x..bx.min.x + bx.sx).map(move |x| Cell::new(x, y, z)))
+        };
+        near.clear();
+        for c in footprint(bottom) {
+            near.extend(tops.get(&c).into_iter().flatten());
+        }
+        for c in footprint(top) {
+            near.extend(bottoms.get(&c).into_iter().flatten());
+        }
+        near.sort_unstable();
+        near.dedup();
         let mut joined = false;
-        for (earlier_instance, earlier, earlier_body) in &placed {
+        for &k in &near {
+            let (earlier_instance, earlier, earlier_body) = &placed[k];
             let Some(dir) = link(earlier_body, &body) else {
                 continue;
             };
@@ -482,6 +506,15 @@ fn count_build(
         }
         if !joined {
             report.starts += 1;
+        }
+        let i = placed.len();
+        for (index, z) in [(&mut tops, top), (&mut bottoms, bottom)] {
+            for c in footprint(z) {
+                let here = index.entry(c).or_default();
+                if here.len() < MAX_PIECES_PER_CELL {
+                    here.push(i);
+                }
+            }
         }
         placed.push((instance, piece, body));
     }
@@ -517,6 +550,9 @@ pub fn catalog_part(written: &str) -> Option<PartKind> {
         _ => None,
     }
 }
+/// How many pieces a cell of [`count_build`]'s index remembers: one in a
+/// build without overlaps; the bound keeps a pile of copies linear.
+const MAX_PIECES_PER_CELL: usize = 8;
 
 /// A part name as reports give it: lower case, without `.dat`.
 fn part_name(written: &str) -> String {

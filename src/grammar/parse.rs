@@ -30,6 +30,7 @@
 //!
 //! Every error names the file and line and says what is wrong.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use thiserror::Error;
@@ -148,12 +149,27 @@ impl RuleSet {
                 format!("{what} in a file of complex rules: it may hold only `complex` blocks"),
             ));
         }
+        // This file's rules were checked against each other as it was read;
+        // against the earlier ones, by hashed keys, not pairwise.
+        let names: HashMap<&str, usize> = self
+            .complex
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.as_str(), i))
+            .collect();
+        let blocks: HashMap<_, usize> = self
+            .complex
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (block_key(p), i))
+            .collect();
         let mut complex = self.complex.clone();
         for r in &found.complex {
-            if let Some(prev) = complex
-                .iter()
-                .find(|p| p.name == r.name || p.same_pieces(r))
-            {
+            let prev = names
+                .get(r.name.as_str())
+                .or_else(|| blocks.get(&block_key(r)))
+                .map(|&i| &self.complex[i]);
+            if let Some(prev) = prev {
                 return Err(RuleError::at(
                     &file,
                     r.line,
@@ -194,6 +210,9 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
     let mut starts: Vec<StartRule> = Vec::new();
     let mut rules: Vec<Rule> = Vec::new();
     let mut complex: Vec<ComplexRule> = Vec::new();
+    // Earlier statements by what makes them the same, for the duplicate
+    // checks (hashed: a file of 200,000 rules is not compared pairwise).
+    let mut seen = Seen::default();
     // Whether the last statement belongs to an open `complex` block.
     let mut in_block = false;
     let mut first_part_line = 0;
@@ -209,7 +228,7 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
         let f: Vec<&str> = body.split_whitespace().collect();
         if in_block && !matches!(f[0], "u" | "v") {
             in_block = false;
-            check_block(&complex, file)?;
+            check_block(&complex, &mut seen, file)?;
         }
         let part = |s: &str| {
             PartKind::from_id(s).ok_or_else(|| {
@@ -309,11 +328,9 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
                     weight,
                     line,
                 };
-                if let Some(prev) = rules.iter().find(|p| {
-                    (p.anchor, p.added, p.added_rot, p.dir, p.dx, p.dy)
-                        == (r.anchor, r.added, r.added_rot, r.dir, r.dx, r.dy)
-                }) {
-                    return Err(err(format!("same rule as line {}", prev.line)));
+                let key = (r.anchor, r.added, r.added_rot, r.dir, r.dx, r.dy);
+                if let Some(prev) = seen.rules.insert(key, line) {
+                    return Err(err(format!("same rule as line {prev}")));
                 }
                 rules.push(r);
             }
@@ -327,12 +344,12 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
                         )))
                     }
                 };
-                if let Some(prev) = complex.iter().find(|r| r.name == name) {
+                if let Some(&prev) = seen.names.get(name) {
                     return Err(err(format!(
-                        "complex rule `{name}` is already defined on line {}",
-                        prev.line
+                        "complex rule `{name}` is already defined on line {prev}"
                     )));
                 }
+                seen.names.insert(name.to_string(), line);
                 complex.push(ComplexRule {
                     name: name.to_string(),
                     u: Vec::new(),
@@ -396,7 +413,7 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
         }
     }
     if in_block {
-        check_block(&complex, file)?;
+        check_block(&complex, &mut seen, file)?;
     }
     Ok(Statements {
         alphabet,
@@ -409,10 +426,32 @@ fn statements(text: &str, file: &str) -> Result<Statements, RuleError> {
     })
 }
 
-/// The checks of a complete `complex` block: both sides have pieces, and
-/// no earlier rule has the same ones.
-fn check_block(complex: &[ComplexRule], file: &str) -> Result<(), RuleError> {
-    let (r, earlier) = complex.split_last().expect("an open block");
+/// What makes a piece of a complex rule the same as another.
+type PieceKey = (PartKind, Rot, i32, i32, super::Plates);
+
+/// What makes two complex rules the same: their `u` and `v` pieces.
+fn block_key(r: &ComplexRule) -> (Vec<PieceKey>, Vec<PieceKey>) {
+    let keys = |ps: &[RulePiece]| -> Vec<PieceKey> {
+        ps.iter().map(|p| (p.part, p.rot, p.x, p.y, p.z)).collect()
+    };
+    (keys(&r.u), keys(&r.v))
+}
+
+/// The statements read so far, keyed by what makes two the same.
+#[derive(Default)]
+struct Seen {
+    /// Basic rules: anchor, added part, its turn, side and offset -> line.
+    rules: HashMap<(PartKind, PartKind, Rot, Dir, i32, i32), usize>,
+    /// Complex rule names -> line.
+    names: HashMap<String, usize>,
+    /// Complex rules' `u` and `v` pieces -> index into the complex rules.
+    blocks: HashMap<(Vec<PieceKey>, Vec<PieceKey>), usize>,
+}
+
+/// The checks of a complete `complex` block (the last of `complex`): both
+/// sides have pieces, and no earlier rule has the same ones.
+fn check_block(complex: &[ComplexRule], seen: &mut Seen, file: &str) -> Result<(), RuleError> {
+    let r = complex.last().expect("an open block");
     for (side, pieces) in [("u", &r.u), ("v", &r.v)] {
         if pieces.is_empty() {
             return Err(RuleError::at(
@@ -425,7 +464,8 @@ fn check_block(complex: &[ComplexRule], file: &str) -> Result<(), RuleError> {
             ));
         }
     }
-    if let Some(prev) = earlier.iter().find(|p| p.same_pieces(r)) {
+    let key = block_key(r);
+    if let Some(prev) = seen.blocks.get(&key).map(|&i| &complex[i]) {
         return Err(RuleError::at(
             file,
             r.line,
@@ -435,6 +475,7 @@ fn check_block(complex: &[ComplexRule], file: &str) -> Result<(), RuleError> {
             ),
         ));
     }
+    seen.blocks.insert(key, complex.len() - 1);
     Ok(())
 }
 

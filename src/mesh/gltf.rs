@@ -21,8 +21,10 @@ use glam::{Mat4, Vec3};
 use super::{finish, Location, Mesh, MeshError};
 
 /// The most triangles a glTF file may expand to once its node instances are
-/// applied; beyond this a file is taken as malicious or broken.
-const MAX_TRIANGLES: usize = 50_000_000;
+/// applied, each node visit counting as one more; beyond this a file is
+/// taken as malicious or broken (a few kilobytes of nodes that list each
+/// other twice over name 2^63 instances).
+const MAX_INSTANCED: u64 = 10_000_000;
 
 /// Parses the glTF (JSON or binary) data in `bytes`, read from `path`.
 /// Relative buffer URIs are resolved inside `path`'s folder only (see
@@ -93,38 +95,115 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         .or_else(|| document.scenes().next());
     match scene {
         Some(scene) => {
-            // Depth-first over the node tree; a valid tree is no deeper than
-            // its node count, so anything deeper is a cycle.
-            let limit = document.nodes().len();
-            let mut stack: Vec<_> = scene.nodes().map(|n| (n, Mat4::IDENTITY, 0usize)).collect();
-            while let Some((node, parent, depth)) = stack.pop() {
-                if depth > limit {
-                    return Err(malformed(
-                        "the node hierarchy has a cycle; re-export the scene".into(),
-                    ));
-                }
+            // What the walk will cost, counted before it starts.
+            let cost = node_costs(&document).map_err(malformed)?;
+            let total = scene
+                .nodes()
+                .fold(0u64, |t, n| t.saturating_add(cost[n.index()]));
+            if total > MAX_INSTANCED {
+                return Err(malformed(too_many()));
+            }
+            let mut warned = vec![false; document.meshes().len()];
+            let mut stack: Vec<_> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+            while let Some((node, parent)) = stack.pop() {
                 let m = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
                 if let Some(mesh) = node.mesh() {
-                    add_mesh(&mesh, m, &buffers, &mut raw).map_err(malformed)?;
+                    let first = !std::mem::replace(&mut warned[mesh.index()], true);
+                    add_mesh(path, &mesh, m, &buffers, &mut raw, first).map_err(malformed)?;
                 }
-                stack.extend(node.children().map(|c| (c, m, depth + 1)));
+                stack.extend(node.children().map(|c| (c, m)));
             }
         }
         None => {
             for mesh in document.meshes() {
-                add_mesh(&mesh, Mat4::IDENTITY, &buffers, &mut raw).map_err(malformed)?;
+                add_mesh(path, &mesh, Mat4::IDENTITY, &buffers, &mut raw, true)
+                    .map_err(malformed)?;
             }
         }
     }
     finish(path, raw)
 }
 
-/// Appends every triangle primitive of `mesh`, transformed by `m`.
+/// The message for a scene past [`MAX_INSTANCED`].
+fn too_many() -> String {
+    format!(
+        "more than {} million triangles and node visits once its nodes are instanced; \
+         simplify the model or flatten its instances",
+        MAX_INSTANCED / 1_000_000
+    )
+}
+
+/// An upper bound on the triangles of one instance of `mesh`, from its
+/// accessors' declared counts (no data read).
+fn mesh_triangles(mesh: &::gltf::Mesh<'_>) -> u64 {
+    mesh.primitives()
+        .map(|p| {
+            let n = match p.indices() {
+                Some(a) => a.count(),
+                None => p.get(&::gltf::Semantic::Positions).map_or(0, |a| a.count()),
+            } as u64;
+            match p.mode() {
+                Mode::Triangles => n / 3,
+                Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+                _ => 0,
+            }
+        })
+        .fold(0, u64::saturating_add)
+}
+
+/// For each node, what walking its subtree once costs: one per node visit
+/// plus the triangles of every mesh instance under it (saturating). Each
+/// node is looked at once, whatever the number of paths to it, so a node
+/// graph that names a node many times over is priced, not walked; a cycle
+/// is an error.
+fn node_costs(document: &::gltf::Document) -> Result<Vec<u64>, String> {
+    let nodes: Vec<_> = document.nodes().collect();
+    let tris: Vec<u64> = document.meshes().map(|m| mesh_triangles(&m)).collect();
+    // 0: not seen, 1: on the path being walked, 2: done.
+    let mut state = vec![0u8; nodes.len()];
+    let mut cost = vec![0u64; nodes.len()];
+    for root in 0..nodes.len() {
+        if state[root] != 0 {
+            continue;
+        }
+        // (node, whether its children are done)
+        let mut stack = vec![(root, false)];
+        while let Some((i, children_done)) = stack.pop() {
+            if children_done {
+                let own = 1 + nodes[i].mesh().map_or(0, |m| tris[m.index()]);
+                cost[i] = nodes[i]
+                    .children()
+                    .fold(own, |t, c| t.saturating_add(cost[c.index()]));
+                state[i] = 2;
+                continue;
+            }
+            if state[i] != 0 {
+                continue;
+            }
+            state[i] = 1;
+            stack.push((i, true));
+            for c in nodes[i].children() {
+                match state[c.index()] {
+                    0 => stack.push((c.index(), false)),
+                    1 => return Err("the node hierarchy has a cycle; re-export the scene".into()),
+                    _ => {}
+                }
+            }
+        }
+    }
+    Ok(cost)
+}
+
+/// Appends every triangle primitive of `mesh`, transformed by `m`; `first`
+/// for the mesh's first instance, the one whose notes become warnings
+/// (naming `path`).
 fn add_mesh(
+    path: &Path,
     mesh: &::gltf::Mesh<'_>,
     m: Mat4,
     buffers: &[&[u8]],
     out: &mut Mesh,
+    first: bool,
 ) -> Result<(), String> {
     let name = mesh.name().map_or_else(
         || format!("mesh {}", mesh.index()),
@@ -196,16 +275,19 @@ fn add_mesh(
         };
         let tris: Vec<[u32; 3]> = tris.map(|t| t.map(|k| indices[k])).collect();
         if let Some(paint) = out.paint.as_mut() {
-            let faces = super::gltf_paint::faces(&prim, buffers, &tris).map_err(|e| here(&e))?;
+            let (faces, note) = super::gltf_paint::faces(&prim, buffers, &tris, positions.len())
+                .map_err(|e| here(&e))?;
             paint.faces.extend(faces);
+            if let Some(note) = note.filter(|_| first) {
+                out.warnings
+                    .push(format!("{}: {}", path.display(), here(&note)));
+            }
         }
         out.triangles
             .extend(tris.iter().map(|t| t.map(|i| i + base)));
         out.positions.extend(positions);
-        if out.triangles.len() > MAX_TRIANGLES {
-            return Err(format!(
-                "more than {MAX_TRIANGLES} triangles once instanced; simplify the model"
-            ));
+        if out.triangles.len() as u64 > MAX_INSTANCED {
+            return Err(too_many());
         }
     }
     Ok(())

@@ -6,20 +6,25 @@
 //! the model (never outside its folder). An image that cannot be had is a
 //! warning naming it; the material's factor stands in.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::texture::WrappingMode;
 use base64::Engine as _;
 
-use super::paint::{inside_folder, Material, Paint, Texture, Wrap};
+use super::paint::{
+    inside_folder, read_side_file, Material, Paint, TextureBudget, Wrap, MAX_SIDE_FILE,
+};
 use super::FacePaint;
 
 /// The largest image file or `data:` URI decoded, in bytes.
-const MAX_IMAGE_BYTES: usize = 256 << 20;
+const MAX_IMAGE_BYTES: usize = MAX_SIDE_FILE as usize;
 
 /// The document's materials, in order (triangles name them by index), with
-/// their textures decoded.
+/// the textures of those some primitive uses decoded: each image once per
+/// wrap mode however many textures name it, all under one
+/// [`TextureBudget`].
 pub(super) fn materials(
     document: &::gltf::Document,
     buffers: &[&[u8]],
@@ -28,23 +33,33 @@ pub(super) fn materials(
 ) -> Paint {
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut paint = Paint::default();
-    let mut decoded: Vec<Option<Option<usize>>> = vec![None; document.textures().len()];
+    let mut used = vec![false; document.materials().len()];
+    for mesh in document.meshes() {
+        for prim in mesh.primitives() {
+            if let Some(u) = prim.material().index().and_then(|i| used.get_mut(i)) {
+                *u = true;
+            }
+        }
+    }
+    let mut budget = TextureBudget::default();
+    let mut decoded: HashMap<(usize, [Wrap; 2]), Option<usize>> = HashMap::new();
     for m in document.materials() {
         let pbr = m.pbr_metallic_roughness();
         let f = pbr.base_color_factor();
         let mut texture = None;
-        if let Some(info) = pbr.base_color_texture() {
+        let info = pbr
+            .base_color_texture()
+            .filter(|_| m.index().is_some_and(|i| used[i]));
+        if let Some(info) = info {
             let t = info.texture();
-            let slot = &mut decoded[t.index()];
-            if slot.is_none() {
-                let image = t.source();
-                let got = image_bytes(&image, buffers, folder).and_then(|b| {
-                    Texture::decode(&b).map_err(|e| format!("cannot be decoded ({e})"))
-                });
-                *slot = Some(match got {
+            let image = t.source();
+            let s = t.sampler();
+            let wraps = [wrap(s.wrap_s()), wrap(s.wrap_t())];
+            texture = *decoded.entry((image.index(), wraps)).or_insert_with(|| {
+                let got = image_bytes(&image, buffers, folder).and_then(|b| budget.decode(&b));
+                match got {
                     Ok(mut tex) => {
-                        let s = t.sampler();
-                        tex.wrap = [wrap(s.wrap_s()), wrap(s.wrap_t())];
+                        tex.wrap = wraps;
                         paint.textures.push(tex);
                         Some(paint.textures.len() - 1)
                     }
@@ -59,9 +74,8 @@ pub(super) fn materials(
                         ));
                         None
                     }
-                });
-            }
-            texture = slot.flatten();
+                }
+            });
         }
         paint.materials.push(Material {
             name: m.name().unwrap_or_default().to_string(),
@@ -117,11 +131,7 @@ fn image_bytes(
             let name = percent_decode(uri);
             let p = inside_folder(folder, &name)
                 .ok_or_else(|| format!("file {name:?} is outside the model's folder"))?;
-            let meta = std::fs::metadata(&p).map_err(|_| format!("file {name:?} is missing"))?;
-            if meta.len() > MAX_IMAGE_BYTES as u64 {
-                return Err(format!("file {name:?} is too large"));
-            }
-            std::fs::read(&p).map_err(|e| format!("file {name:?} cannot be read ({e})"))
+            read_side_file(&p, MAX_SIDE_FILE).map_err(|why| format!("file {name:?} {why}"))
         }
     }
 }
@@ -146,13 +156,15 @@ fn percent_decode(s: &str) -> String {
 }
 
 /// The paint of each triangle `tris` (corner indices into the primitive's
-/// vertices) of `prim`: its material, texture coordinates (the set its
-/// material samples) and `COLOR_0`.
+/// `vertices`) of `prim`: its material, texture coordinates (the set its
+/// material samples) and `COLOR_0`; and a note when some of it is ignored
+/// (a `COLOR_0` or texture coordinate list shorter than the vertex list).
 pub(super) fn faces(
     prim: &::gltf::Primitive<'_>,
     buffers: &[&[u8]],
     tris: &[[u32; 3]],
-) -> Result<Vec<FacePaint>, String> {
+    vertices: usize,
+) -> Result<(Vec<FacePaint>, Option<String>), String> {
     let material = prim.material().index().map(|i| i as u32);
     let set = prim
         .material()
@@ -177,11 +189,30 @@ pub(super) fn faces(
         }
         None => None,
     };
+    let mut note = None;
+    if let Some((c, n)) = &colors {
+        if c.len() / n < vertices {
+            note = Some(format!(
+                "COLOR_0 has {} colours for {vertices} vertices; the triangles past it are \
+                 not vertex-coloured (re-export the colours)",
+                c.len() / n
+            ));
+        }
+    }
+    if let Some(u) = &uvs {
+        if u.len() / 2 < vertices && note.is_none() {
+            note = Some(format!(
+                "the texture coordinates number {} for {vertices} vertices; the triangles \
+                 past them are not textured (re-export the model)",
+                u.len() / 2
+            ));
+        }
+    }
     let corner = |v: &[f32], n: usize, i: u32| -> Option<Vec<f32>> {
         let i = i as usize * n;
         v.get(i..i + n).map(<[f32]>::to_vec)
     };
-    Ok(tris
+    let faces = tris
         .iter()
         .map(|t| FacePaint {
             material,
@@ -195,7 +226,8 @@ pub(super) fn faces(
                 Some([a?, b?, c?].map(|v| [v[0], v[1], v[2]]))
             }),
         })
-        .collect())
+        .collect();
+    Ok((faces, note))
 }
 
 /// An accessor of `n` components per element as floats: `f32`, or

@@ -33,6 +33,7 @@
 mod buffers;
 mod gltf;
 mod gltf_paint;
+pub mod mtl;
 mod obj;
 pub mod paint;
 mod stl;

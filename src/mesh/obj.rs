@@ -8,69 +8,152 @@
 //! those are reported as `file.obj:17: ...`. Only what gets past that check
 //! is handed to `tobj`.
 
-use std::path::Path;
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::paint::{srgb_to_linear, Texture};
+use super::mtl::{self, MtlMaterial};
+use super::paint::{inside_folder, read_side_file, srgb_to_linear, TextureBudget, MAX_SIDE_FILE};
 use super::{finish, FacePaint, Location, Material, Mesh, MeshError, Paint};
 
-/// The largest material library or texture file read, in bytes.
-const MAX_SIDE_FILE: u64 = 256 << 20;
-
-/// Reads a side file (material library or texture), refusing huge ones.
-fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|_| "is missing".to_string())?;
-    if meta.len() > MAX_SIDE_FILE {
-        return Err(format!("is larger than {} MB", MAX_SIDE_FILE >> 20));
-    }
-    std::fs::read(path).map_err(|e| format!("cannot be read ({e})"))
-}
+/// The most skipped-line warnings given for one material library; past
+/// them one line says how many more there were.
+const MAX_MTL_WARNINGS: usize = 5;
 
 /// The OBJ's materials as [`Material`]s: `Kd` (sRGB) as the base colour and
-/// `map_Kd` decoded from the OBJ's folder. A texture that is missing or
-/// cannot be decoded is a warning naming it, and `Kd` stands in.
+/// `map_Kd` decoded from the OBJ's folder, for the materials some face uses
+/// (`used`) only. Each texture file is decoded once however many materials
+/// name it, all of them under one [`TextureBudget`]. A texture that is
+/// missing or cannot be decoded is a warning naming it, and `Kd` stands in.
 fn obj_materials(
     path: &Path,
     folder: &Path,
-    mats: &[tobj::Material],
+    mats: &[MtlMaterial],
+    used: &[bool],
     warnings: &mut Vec<String>,
 ) -> Paint {
     let mut paint = Paint::default();
-    for m in mats {
-        let kd = m.diffuse.unwrap_or([1.0; 3]);
+    let mut budget = TextureBudget::default();
+    let mut decoded: HashMap<PathBuf, Option<usize>> = HashMap::new();
+    for (i, m) in mats.iter().enumerate() {
+        let kd = m.kd.unwrap_or([1.0; 3]);
         let mut texture = None;
-        if let Some(name) = m
-            .diffuse_texture
-            .as_deref()
-            .filter(|n| !n.trim().is_empty())
-        {
-            // `map_Kd -opt ... file`: the file is the last word.
-            let file = name.split_whitespace().last().unwrap_or(name);
-            let loaded = super::paint::inside_folder(folder, file)
+        if let Some(file) = m.map_kd.as_deref().filter(|_| used[i]) {
+            let loaded = inside_folder(folder, file)
                 .ok_or_else(|| "is outside the model's folder".to_string())
-                .and_then(|p| read_bounded(&p))
-                .and_then(|b| Texture::decode(&b).map_err(|e| format!("cannot be decoded ({e})")));
-            match loaded {
-                Ok(t) => {
-                    texture = Some(paint.textures.len());
-                    paint.textures.push(t);
+                .map(|p| p.canonicalize().unwrap_or(p));
+            texture = match loaded {
+                Ok(p) => match decoded.get(&p) {
+                    Some(&t) => t,
+                    None => {
+                        let got = read_side_file(&p, MAX_SIDE_FILE).and_then(|b| budget.decode(&b));
+                        let t = match got {
+                            Ok(t) => {
+                                paint.textures.push(t);
+                                Some(paint.textures.len() - 1)
+                            }
+                            Err(why) => {
+                                warnings.push(texture_warning(path, file, &m.name, &why));
+                                None
+                            }
+                        };
+                        decoded.insert(p, t);
+                        t
+                    }
+                },
+                Err(why) => {
+                    warnings.push(texture_warning(path, file, &m.name, &why));
+                    None
                 }
-                Err(why) => warnings.push(format!(
-                    "{}: texture {file:?} of material {:?} {why}; its Kd colour stands in",
-                    path.display(),
-                    m.name
-                )),
-            }
+            };
         }
         paint.materials.push(Material {
             name: m.name.clone(),
-            color: kd.map(|c| srgb_to_linear(c.clamp(0.0, 1.0))),
+            color: kd.map(srgb_to_linear),
             texture,
             flip_v: true,
         });
     }
     paint
+}
+
+/// The warning for a texture that could not be had.
+fn texture_warning(path: &Path, file: &str, material: &str, why: &str) -> String {
+    format!(
+        "{}: texture {file:?} of material {material:?} {why}; its Kd colour stands in",
+        path.display()
+    )
+}
+
+/// Reads the material libraries an OBJ names, each once (by resolved
+/// path) however often `mtllib` repeats it, with our own MTL parser; the
+/// materials gathered in the order `tobj` numbers them.
+#[derive(Default)]
+struct Libraries {
+    read: HashSet<PathBuf>,
+    materials: Vec<MtlMaterial>,
+    warnings: Vec<String>,
+}
+
+impl Libraries {
+    /// `tobj`'s material loader: the library `name` (relative to `folder`)
+    /// as names only (what `usemtl` needs); its colours are kept here.
+    fn load(&mut self, path: &Path, folder: &Path, name: &Path) -> tobj::MTLLoadResult {
+        let shown = name.display().to_string();
+        let mut warn = |why: &str| {
+            self.warnings.push(format!(
+                "{}: material library {shown:?} {why}; its materials are ignored",
+                path.display()
+            ))
+        };
+        let Some(file) = inside_folder(folder, &shown) else {
+            warn("is outside the model's folder");
+            return Ok(Default::default());
+        };
+        if !self
+            .read
+            .insert(file.canonicalize().unwrap_or(file.clone()))
+        {
+            return Ok(Default::default());
+        }
+        let lib = match read_side_file(&file, MAX_SIDE_FILE) {
+            Ok(bytes) => mtl::parse(&String::from_utf8_lossy(&bytes)),
+            Err(why) => {
+                warn(&why);
+                return Ok(Default::default());
+            }
+        };
+        for (line, why) in lib.skipped.iter().take(MAX_MTL_WARNINGS) {
+            self.warnings.push(format!(
+                "{}:{line}: {why}; the line is skipped",
+                file.display()
+            ));
+        }
+        if lib.skipped.len() > MAX_MTL_WARNINGS {
+            self.warnings.push(format!(
+                "{}: {} more malformed lines skipped",
+                file.display(),
+                lib.skipped.len() - MAX_MTL_WARNINGS
+            ));
+        }
+        let names: Vec<tobj::Material> = lib
+            .materials
+            .iter()
+            .map(|m| tobj::Material {
+                name: m.name.clone(),
+                ..tobj::Material::default()
+            })
+            .collect();
+        let map = names
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (m.name.clone(), i))
+            .collect();
+        self.materials.extend(lib.materials);
+        Ok((names, map))
+    }
 }
 
 /// Parses the OBJ text in `bytes` (read from `path`, used in messages).
@@ -85,43 +168,26 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     // Material libraries are read only from the OBJ's own folder; one that
     // is missing or unreadable is a warning, and its faces go uncoloured.
     let folder = path.parent().unwrap_or(Path::new("."));
-    let warnings = std::cell::RefCell::new(Vec::new());
-    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |name| {
-        let shown = name.display().to_string();
-        let bytes = super::paint::inside_folder(folder, &shown)
-            .ok_or_else(|| "is outside the model's folder".to_string())
-            .and_then(|p| read_bounded(&p));
-        match bytes {
-            Ok(b) => tobj::load_mtl_buf(&mut b.as_slice()).or_else(|e| {
-                warnings.borrow_mut().push(format!(
-                    "{}: material library {shown:?} is not valid ({e}); its materials are ignored",
-                    path.display()
-                ));
-                Ok(Default::default())
-            }),
-            Err(why) => {
-                warnings.borrow_mut().push(format!(
-                    "{}: material library {shown:?} {why}; its materials are ignored",
-                    path.display()
-                ));
-                Ok(Default::default())
-            }
-        }
+    let libs = RefCell::new(Libraries::default());
+    let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |name| {
+        libs.borrow_mut().load(path, folder, name)
     })
     .map_err(|e| MeshError::Malformed {
         at: Location::file(path),
         reason: format!("not a valid OBJ file ({e}); re-export it"),
     })?;
+    let libs = libs.into_inner();
+    let mut used = vec![false; libs.materials.len()];
+    for model in &models {
+        if let Some(u) = model.mesh.material_id.and_then(|i| used.get_mut(i)) {
+            *u |= !model.mesh.indices.is_empty();
+        }
+    }
     let mut raw = Mesh {
-        warnings: warnings.into_inner(),
+        warnings: libs.warnings,
         ..Mesh::default()
     };
-    let paint = obj_materials(
-        path,
-        folder,
-        &materials.unwrap_or_default(),
-        &mut raw.warnings,
-    );
+    let paint = obj_materials(path, folder, &libs.materials, &used, &mut raw.warnings);
     let mut faces = Vec::new();
     for model in &models {
         let m = &model.mesh;

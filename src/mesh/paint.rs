@@ -17,9 +17,17 @@ use std::path::{Component, Path, PathBuf};
 /// The widest or tallest texture accepted, in texels.
 pub const MAX_TEXTURE_SIDE: u32 = 8192;
 
+/// The most texels decoded for one model, all its textures together (one
+/// image of [`MAX_TEXTURE_SIDE`] a side, 256 MB as RGBA): a texture that
+/// would pass it is a warning and its material's colour stands in.
+pub const MAX_MODEL_TEXELS: u64 = (MAX_TEXTURE_SIDE as u64) * (MAX_TEXTURE_SIDE as u64);
+
+/// The largest side file (material library or image) read, in bytes.
+pub const MAX_SIDE_FILE: u64 = 256 << 20;
+
 /// How texture coordinates outside `[0, 1]` wrap (glTF's sampler modes;
 /// OBJ textures repeat).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Wrap {
     /// Tile the texture (the default).
     #[default]
@@ -80,6 +88,15 @@ impl Texture {
             texels: img.pixels().map(|p| p.0).collect(),
             wrap: [Wrap::Repeat; 2],
         })
+    }
+
+    /// The width and height `bytes` declare, read from the header only.
+    pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| e.to_string())?
+            .into_dimensions()
+            .map_err(|e| e.to_string())
     }
 
     /// The texel at `uv` (nearest; `v` = 0 is the top row, as in glTF), in
@@ -189,6 +206,68 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     }
+}
+
+/// Decodes a model's textures under one budget of texels for them all
+/// ([`MAX_MODEL_TEXELS`]): however many materials name however large
+/// images, memory stays bounded. Callers decode each source once (a cache
+/// by resolved path or image index) and only for materials in use.
+#[derive(Debug)]
+pub(crate) struct TextureBudget {
+    left: u64,
+}
+
+impl Default for TextureBudget {
+    fn default() -> Self {
+        TextureBudget {
+            left: MAX_MODEL_TEXELS,
+        }
+    }
+}
+
+impl TextureBudget {
+    /// Decodes `bytes` if its texels fit what is left of the budget.
+    pub(crate) fn decode(&mut self, bytes: &[u8]) -> Result<Texture, String> {
+        let (w, h) = Texture::dimensions(bytes).map_err(|e| format!("cannot be decoded ({e})"))?;
+        let texels = u64::from(w) * u64::from(h);
+        if texels > self.left {
+            return Err(format!(
+                "is not decoded: its {w} x {h} texels would pass the limit of {} million \
+                 texels for all of a model's textures together (shrink the images)",
+                MAX_MODEL_TEXELS / 1_000_000
+            ));
+        }
+        self.left -= texels;
+        Texture::decode(bytes).map_err(|e| format!("cannot be decoded ({e})"))
+    }
+}
+
+/// The bytes of a side file a model names (material library, texture),
+/// at most `max` of them. Only a regular file is opened (checked on the
+/// link-resolved path before opening, and again on the open file): a FIFO
+/// or a device is refused, never read, so nothing blocks. The error is a
+/// phrase to follow the file's name ("is missing", "is not a regular file").
+pub(crate) fn read_side_file(path: &Path, max: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|_| "is missing".to_string())?;
+    if !meta.is_file() {
+        return Err("is not a regular file".into());
+    }
+    if meta.len() > max {
+        return Err(format!("is larger than {} MB", max >> 20));
+    }
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    if !file.metadata().is_ok_and(|m| m.is_file()) {
+        return Err("is not a regular file".into());
+    }
+    let mut out = Vec::with_capacity(meta.len() as usize);
+    file.take(max + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| format!("cannot be read ({e})"))?;
+    if out.len() as u64 > max {
+        return Err(format!("is larger than {} MB", max >> 20));
+    }
+    Ok(out)
 }
 
 /// `name` resolved inside `folder`, or `None` when it would leave it (an

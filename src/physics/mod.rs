@@ -121,6 +121,7 @@
 //! ```
 
 mod compression;
+mod groups;
 mod model;
 pub mod repair;
 mod steps;

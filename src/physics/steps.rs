@@ -1,5 +1,6 @@
-//! Groups of touching pieces, kept as pieces are added step by step, and
-//! the parallel solving of the groups that grew.
+//! The step check: the groups of touching pieces that grew at each step
+//! (see [`groups`](super::groups)) solved in parallel, a batch of steps at
+//! a time.
 
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
@@ -9,102 +10,9 @@ use rayon::prelude::*;
 use crate::assembly::Assembly;
 
 use super::compression;
+use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
 use super::model::{solve, Contact, Structure};
 use super::{weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis};
-
-/// Union-find over piece indices, with whether each group touches the
-/// ground.
-struct Groups {
-    parent: Vec<usize>,
-    grounded: Vec<bool>,
-}
-
-impl Groups {
-    fn new() -> Groups {
-        Groups {
-            parent: Vec::new(),
-            grounded: Vec::new(),
-        }
-    }
-
-    fn add(&mut self, grounded: bool) {
-        self.parent.push(self.parent.len());
-        self.grounded.push(grounded);
-    }
-
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.parent[i] != i {
-            self.parent[i] = self.parent[self.parent[i]];
-            i = self.parent[i];
-        }
-        i
-    }
-
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            // The smaller index becomes the root: deterministic.
-            let (root, child) = (ra.min(rb), ra.max(rb));
-            self.parent[child] = root;
-            self.grounded[root] |= self.grounded[child];
-        }
-    }
-}
-
-/// One program to solve: a group of the build after some step.
-struct Job {
-    /// The group's pieces, sorted.
-    pieces: Vec<usize>,
-    /// Indices into the structure's contacts.
-    contacts: Vec<usize>,
-    grounded: bool,
-}
-
-/// Advances the groups to the first `end` pieces and returns a job for
-/// every group that gained pieces, with `reused` counting the groups that
-/// did not.
-fn jobs_for_step(
-    s: &Structure,
-    g: &mut Groups,
-    next_contact: &mut usize,
-    end: usize,
-    reused: &mut usize,
-) -> Vec<Job> {
-    let start = g.parent.len();
-    for p in start..end {
-        g.add(s.grounded(p));
-    }
-    let mut c = *next_contact;
-    while c < s.contacts.len() && s.contacts[c].below.max(s.contacts[c].above) < end {
-        g.union(s.contacts[c].below, s.contacts[c].above);
-        c += 1;
-    }
-    *next_contact = c;
-    let mut touched: Vec<usize> = (start..end).map(|p| g.find(p)).collect();
-    touched.sort_unstable();
-    touched.dedup();
-    let roots: Vec<usize> = (0..end).map(|p| g.find(p)).collect();
-    let groups = roots.iter().enumerate().filter(|&(p, &r)| p == r).count();
-    *reused += groups - touched.len();
-    touched
-        .into_iter()
-        .map(|root| Job {
-            pieces: (0..end).filter(|&p| roots[p] == root).collect(),
-            contacts: (0..c)
-                .filter(|&k| roots[s.contacts[k].below] == root)
-                .collect(),
-            grounded: g.grounded[root],
-        })
-        .collect()
-}
-
-/// Whether every piece a job adds (from `begin` on) rests straight down
-/// on the ground through the first `end` pieces.
-fn drops(s: &Structure, job: &Job, begin: usize, end: usize) -> bool {
-    job.pieces
-        .iter()
-        .all(|&p| p < begin || s.drops_straight(p, end))
-}
 
 /// How a job's answer was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -608,8 +516,7 @@ fn check_steps_in(
             _ => bounds.push((p.step.0, i + 1)),
         }
     }
-    let mut g = Groups::new();
-    let (mut next, mut reused, mut solves, mut certified) = (0, 0, 0, 0);
+    let (mut reused, mut solves, mut certified) = (0, 0, 0);
     let mut current = vec![PieceStress::falling(); n];
     // Whether each piece's entry in `current` is exact: found for the
     // group it is in now (see `solve_all_but`).
@@ -625,32 +532,13 @@ fn check_steps_in(
         .iter()
         .position(|b| b.0 >= from)
         .unwrap_or(bounds.len().saturating_sub(1));
-    let mut all_jobs: Vec<Vec<Job>> = Vec::with_capacity(bounds.len());
-    for (k, &(_, end)) in bounds.iter().enumerate() {
-        let before = reused;
-        all_jobs.push(jobs_for_step(s, &mut g, &mut next, end, &mut reused));
-        if k0 > 0 && k <= k0 {
-            // Skipped, or solved whole: nothing of it is reused.
-            reused = before;
-        }
-    }
     let last_k = bounds.len().saturating_sub(1);
     let first_batch = if k0 > 0 { k0 + 1 } else { 0 };
-    let mut begin = 0;
-    let mut ahead: Vec<(usize, usize)> = Vec::new();
-    for (k, jobs) in all_jobs.iter().enumerate() {
-        let end = bounds[k].1;
-        if k < k0 || (k == k0 && k0 > 0) {
-            begin = end;
-            continue;
-        }
-        for (j, job) in jobs.iter().enumerate() {
-            if !(job.grounded && drops(s, job, begin, end)) {
-                ahead.push((k, j));
-            }
-        }
-        begin = end;
-    }
+    // The steps' groups are made as the check reaches them, a batch ahead
+    // at most: a group lists all its pieces, so keeping every step's at
+    // once took memory growing with the square of the steps (a column of
+    // 10,000 bricks, one a step: 1.35 GB).
+    let mut window = JobWindow::new(s, &bounds, k0);
     // The seconds of the biggest program of the step checked last.
     let mut step_seconds = 0.0;
     let mut reserve = Reserve {
@@ -664,20 +552,20 @@ fn check_steps_in(
     // Whether a batch had the last step's programs.
     let mut last_batched = false;
     let total = bounds.len() as u64;
-    for (k, jobs) in all_jobs.iter().enumerate() {
+    for (k, &(step, end)) in bounds.iter().enumerate() {
         if let Some(tell) = tell {
             tell(k as u64, total);
         }
         if k < k0 {
-            begin = bounds[k].1;
+            begin = end;
             continue;
         }
         if k == k0 && k0 > 0 {
+            window.skip_to(k + 1);
             if past(fin.cut(&reserve, deadline, start, true)?) {
                 complete = false;
                 break;
             }
-            let (step, end) = bounds[k];
             // The last step, whole: the finished model, made alongside.
             let made = if k == last_k && fin.covers_last() {
                 fin.wait()?.cloned()
@@ -722,14 +610,14 @@ fn check_steps_in(
             // This batch's programs, all at once. The last step's groups
             // are the finished model's: made alongside, they take its
             // answers.
-            let batch: Vec<(usize, usize)> = ahead
-                .iter()
-                .copied()
+            window.make_to(k + STEPS_A_BATCH);
+            let batch: Vec<(usize, usize)> = window
+                .ahead()
                 .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
                 .filter(|&(s, _)| s != last_k || !fin.covers_last())
                 .collect();
             last_batched |= batch.iter().any(|&(s, _)| s == last_k);
-            let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| &all_jobs[k][j]).collect();
+            let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| window.job(k, j)).collect();
             // A program that would start past the deadline is left out:
             // its step stops the check below (a batch of big programs
             // started just before the deadline would overrun it by
@@ -744,7 +632,8 @@ fn check_steps_in(
                 }
             }
         }
-        let (step, end) = bounds[k];
+        window.make_to(k + 1);
+        let jobs = window.take(k);
         step_seconds = 0.0;
         let mut late = Vec::new();
         for (j, job) in jobs.iter().enumerate() {
@@ -812,6 +701,8 @@ fn check_steps_in(
             }
         }
     }
+    // The steps not reached still count their groups that did not grow.
+    let reused = reused + window.finish();
     // The finished build (or the failing step) afresh; past the deadline,
     // the finished build.
     let end = if complete { begin } else { n };

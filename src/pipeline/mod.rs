@@ -139,7 +139,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     };
 
     let pages = booklet.as_ref().map(|b| b.pages);
-    let report = report::compose(
+    let mut report = report::compose(
         opts,
         &setup.rules,
         &mesh,
@@ -149,6 +149,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
         pages,
         times,
     );
+    report.warnings.extend(planner.notes());
     progress.stage("writing");
     let report = write::write(
         opts,

@@ -126,7 +126,9 @@ fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, Re
     }
     let opts = options();
     let (w, h) = (opts.width, opts.height);
-    let exploded = StepRenderer::new(scene, &opts)?.model_image();
+    // Only the finished picture is drawn: no step framing (zoom) to work
+    // out, as it never changes that picture.
+    let exploded = StepRenderer::new(scene, &opts.with_zoom(false))?.model_image();
     let small = image::imageops::resize(model, w / 3, h / 3, image::imageops::FilterType::Triangle);
     let mut out = RgbaImage::from_pixel(w, h + h / 3, image::Rgba([255, 255, 255, 255]));
     image::imageops::overlay(&mut out, &small, i64::from(w - w / 3), 0);

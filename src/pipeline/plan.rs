@@ -1,7 +1,7 @@
 //! The layout and order stages: the search lays the pieces, the verifier
 //! checks them, and they are put in steps a builder can follow.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 use super::error::cover_error;
@@ -25,7 +25,15 @@ pub(super) struct Planner<'a> {
     file: String,
     /// Time spent verifying, across plans.
     verify_secs: Cell<f64>,
+    /// Notes for the report's warnings.
+    notes: RefCell<Vec<String>>,
 }
+
+/// Layouts made again with other seeds when one fails verification.
+const RELAYOUTS: u64 = 4;
+
+/// How far apart the seeds of layouts made again are.
+const RELAYOUT_STRIDE: u64 = 1_000_003;
 
 impl<'a> Planner<'a> {
     pub(super) fn new(
@@ -41,6 +49,7 @@ impl<'a> Planner<'a> {
             progress,
             file: opts.input.display().to_string(),
             verify_secs: Cell::new(0.0),
+            notes: RefCell::new(Vec::new()),
         }
     }
 
@@ -118,27 +127,72 @@ impl<'a> Planner<'a> {
         self.plan_told(seed, false)
     }
 
-    /// [`Self::plan`]; `told`: the layout's progress is shown.
+    /// [`Self::plan`]; `told`: the layout's progress is shown. A layout
+    /// that fails verification is never handed on: the layout is made
+    /// again with other seeds ([`RELAYOUTS`] at most), and the notes say
+    /// so; if none verifies, the first failure is the error (a bug).
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
-        let (outcome, assembly) = self.layout(seed, told)?;
-        let t = Instant::now();
-        let (assembly, order) = self.order(&outcome, assembly)?;
-        self.verify_secs.set(self.verify_secs.get() + secs(t));
-        Ok((outcome, assembly, order))
+        let mut first_failure = None;
+        // The slopes capping the stairs are the one late change to the
+        // layout: a build they leave unverified is laid without them too.
+        let caps: &[bool] = if self.opts.search.cap_stairs && self.opts.slopes {
+            &[true, false]
+        } else {
+            &[true]
+        };
+        for k in 0..=RELAYOUTS {
+            for &cap in caps {
+                let s = seed.wrapping_add(k * RELAYOUT_STRIDE);
+                let (outcome, assembly) = self.layout(s, told && k == 0 && cap, cap)?;
+                let t = Instant::now();
+                let ordered = self.order(&outcome, assembly);
+                self.verify_secs.set(self.verify_secs.get() + secs(t));
+                match ordered {
+                    Ok((assembly, order)) => {
+                        if let Some(BuildError::Unverified { report, .. }) = &first_failure {
+                            self.notes.borrow_mut().push(format!(
+                                "{}: the layout with seed {seed} failed verification ({}); the build is the layout with seed {s}{}, which passed",
+                                self.file,
+                                report.lines().nth(1).unwrap_or(report).trim_start_matches(['-', ' ']),
+                                if cap { "" } else { " without the slopes capping its stairs" }
+                            ));
+                        }
+                        return Ok((outcome, assembly, order));
+                    }
+                    Err(e @ BuildError::Unverified { .. }) => {
+                        first_failure.get_or_insert(e);
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+        Err(first_failure.expect("a failure was kept"))
+    }
+
+    /// What a user should know about the plans made: layouts that failed
+    /// verification and were made again.
+    pub(super) fn notes(&self) -> Vec<String> {
+        self.notes.borrow().clone()
     }
 
     /// The search's pieces for `seed`, painted; `told`: how far it is
-    /// goes to the progress display.
+    /// goes to the progress display; `cap`: stair edges are capped with
+    /// slopes (see [`SearchOptions::cap_stairs`]).
     pub(super) fn layout(
         &self,
         seed: u64,
         told: bool,
+        cap: bool,
     ) -> Result<(SearchOutcome, Assembly), BuildError> {
         let opts = self.opts;
         let model = &self.voxels.model;
         let tell = |done, total| self.progress.advance(done, total);
         let guide = self.guide(told.then_some(&tell as &dyn Fn(u64, u64)));
-        let search_opts = opts.search.clone().with_seed(seed);
+        let search_opts = opts
+            .search
+            .clone()
+            .with_seed(seed)
+            .with_cap_stairs(cap && opts.search.cap_stairs);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
                 file: self.file.clone(),

@@ -148,6 +148,13 @@ pub struct Quality {
     pub extent_studs: i32,
     /// The longest side asked for (`--studs`), if sized that way.
     pub requested_studs: Option<u32>,
+    /// Stair edges, on the top and on the underside: where a column
+    /// stands one to three plates above (below, underneath) a neighbouring
+    /// column (see [`crate::assembly::stairs`]).
+    pub stair_edges: crate::assembly::stairs::TopUnder,
+    /// Of `stair_edges`, those a slope caps facing down the step (an
+    /// inverted slope, underneath).
+    pub stair_edges_capped: crate::assembly::stairs::TopUnder,
 }
 
 impl Quality {
@@ -175,6 +182,7 @@ impl Quality {
             );
         }
         let round = |x: f64, k: f64| (x * k).round() / k;
+        let stairs = crate::assembly::stairs::stair_edges(asm);
         Quality {
             left_out: rep.left_out + rep.budget_left_out,
             left_out_places: rep.left_out_places.clone(),
@@ -187,6 +195,8 @@ impl Quality {
                 Sizing::Studs(k) => Some(k),
                 Sizing::Height(_) => None,
             },
+            stair_edges: stairs.edges,
+            stair_edges_capped: stairs.capped,
         }
     }
 }

@@ -219,7 +219,12 @@ pub fn settle(
             }
             tried += 1;
             let other = seed.wrapping_add(k);
-            let planned = replan(other)?;
+            // A layout that cannot be verified is not a candidate.
+            let planned = match replan(other) {
+                Ok(p) => p,
+                Err(crate::pipeline::BuildError::Unverified { .. }) => continue,
+                Err(e) => return Err(e),
+            };
             // The finished model first: one analysis rules most layouts out.
             let last = analyze(&planned.1, params)?;
             counts.solves += 1;

@@ -69,7 +69,9 @@ fn ldr_meta(
 /// Writes every output `opts.formats` names and `report.json` into
 /// `opts.out_dir`. Every file is staged first and renamed into place
 /// together, so a failed run leaves none of them (and no folder this run
-/// made). Returns the report as written: with its outputs and write time.
+/// made), and an interrupted one is finished or undone by the next
+/// ([`Outputs`]). Returns the report as written: with its outputs and
+/// write time.
 pub(super) fn write(
     opts: &BuildOptions,
     rules: &RuleSet,
@@ -91,7 +93,7 @@ pub(super) fn write(
     let report_path = opts.out_dir.join("report.json");
     let meta = ldr_meta(opts, pictures, settled, rules);
     let parts = PartsList::of(assembly);
-    let mut files = Outputs::new();
+    let mut files = Outputs::new(&opts.out_dir).map_err(failed(&opts.out_dir))?;
     for format in opts.formats.iter() {
         let path = opts.out_dir.join(format.file_name(stem));
         let written = match (format, rendered) {

@@ -127,10 +127,10 @@ impl Camera {
         height: u32,
         margin: u32,
     ) -> Camera {
+        // The view's axes are worked out once, not once a point: their
+        // trigonometry cost more than the points themselves.
         let mut bounds = Bounds::EMPTY;
-        for p in points {
-            bounds.add(view, p);
-        }
+        bounds.extend(view, points);
         Camera::fit_bounds(view, &bounds, width, height, margin)
     }
 
@@ -254,16 +254,8 @@ impl Bounds {
         hi_depth: f32::NEG_INFINITY,
     };
 
-    /// Grows the bounds to hold `p` as `view` sees it; a point that is
-    /// not finite is left out.
-    pub(crate) fn add(&mut self, view: &View, p: Vec3) {
-        let forward = -view.toward_eye();
-        let right = forward.cross(UP).try_normalize().unwrap_or(Vec3::X);
-        let down = forward.cross(right);
-        self.add_on_axes(right, down, forward, p);
-    }
-
-    /// Grows the bounds to hold every one of `points` as `view` sees them.
+    /// Grows the bounds to hold every one of `points` as `view` sees them;
+    /// a point that is not finite is left out.
     pub(crate) fn extend(&mut self, view: &View, points: impl IntoIterator<Item = Vec3>) {
         let forward = -view.toward_eye();
         let right = forward.cross(UP).try_normalize().unwrap_or(Vec3::X);

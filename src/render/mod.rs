@@ -170,7 +170,8 @@ pub fn write_steps(
 /// The finished model, every piece plain. An empty assembly gives a blank
 /// image.
 pub fn model_image(assembly: &Assembly, opts: &RenderOptions) -> Result<RgbaImage, RenderError> {
-    Ok(renderer(assembly, opts)?.model_image())
+    // Framing the steps (zoom) never changes the finished model's view.
+    Ok(renderer(assembly, &opts.with_zoom(false))?.model_image())
 }
 
 /// The finished model with piece `i` of `assembly.pieces` in `colors[i]`
@@ -205,7 +206,7 @@ pub fn model_image_with_colors(
 ) -> Result<RgbaImage, RenderError> {
     let mut scene = Scene::from_assembly(assembly);
     scene.recolor(colors)?;
-    Ok(StepRenderer::new(scene, opts)?.model_image())
+    Ok(StepRenderer::new(scene, &opts.with_zoom(false))?.model_image())
 }
 
 /// One part alone in `color`, [`PART_IMAGE_SIZE`] pixels square on white,

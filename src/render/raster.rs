@@ -212,10 +212,10 @@ impl Samples {
         let (a2, b2, c2) = (a.truncate(), b.truncate(), c.truncate());
         let lo = a2.min(b2).min(c2);
         let hi = a2.max(b2).max(c2);
-        let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
-        let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
-        let x1 = ((hi.x - 0.5).floor() + 1.0).clamp(0.0, self.w as f32) as usize;
-        let y1 = ((hi.y - 0.5).floor() + 1.0).clamp(0.0, self.h as f32) as usize;
+        let x0 = ceil(lo.x - 0.5).max(0.0) as usize;
+        let y0 = ceil(lo.y - 0.5).max(0.0) as usize;
+        let x1 = (floor(hi.x - 0.5) + 1.0).clamp(0.0, self.w as f32) as usize;
+        let y1 = (floor(hi.y - 0.5) + 1.0).clamp(0.0, self.h as f32) as usize;
         if x0 >= x1 || y0 >= y1 {
             return;
         }
@@ -256,9 +256,9 @@ impl Samples {
                 let cross = -r / ea - 0.5;
                 let slack = 1.0 + (e.1.abs() * py + e.2.abs() + ea.abs() * hi) * 1e-6 / ea.abs();
                 if ea > 0.0 {
-                    lo = lo.max((cross - slack).floor());
+                    lo = lo.max(floor(cross - slack));
                 } else {
-                    hi = hi.min((cross + slack).ceil() + 1.0);
+                    hi = hi.min(ceil(cross + slack) + 1.0);
                 }
             }
             if lo >= hi {
@@ -287,6 +287,39 @@ impl Samples {
                 }
             }
         }
+    }
+}
+
+/// `x.floor()`, inline: without SSE4.1 (the baseline x86-64 target) the
+/// standard one is a call into libm, and the fill rounds a few values a
+/// row of every triangle. Exact: a float of magnitude 2^23 or more (or
+/// not finite) is its own floor.
+#[inline(always)]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t > x {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        x
+    }
+}
+
+/// `x.ceil()`, inline, exact (see [`floor`]).
+#[inline(always)]
+fn ceil(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t < x {
+            t + 1.0
+        } else {
+            t
+        }
+    } else {
+        x
     }
 }
 
@@ -391,6 +424,34 @@ mod tests {
             // Samples next to the diagonal, well inside the quad.
             assert_ne!(both.piece[k * 16 + k], EMPTY, "gap at ({k}, {k})");
         }
+    }
+
+    #[test]
+    fn inline_floor_and_ceil_match_the_standard_ones() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999_999_8,
+            -2.999_999_8,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            1e20,
+            -1e20,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        // A sweep through the range pictures use, in odd steps.
+        xs.extend((-40_000..40_000).map(|k| k as f32 * 0.173_1));
+        for x in xs {
+            assert_eq!(floor(x), x.floor(), "floor({x})");
+            assert_eq!(ceil(x), x.ceil(), "ceil({x})");
+        }
+        assert!(floor(f32::NAN).is_nan() && ceil(f32::NAN).is_nan());
     }
 
     #[test]

@@ -333,7 +333,21 @@ impl Layout<'_> {
                     col.push(q);
                     q = q.offset(0, 0, dz);
                 }
-                if q.z >= 0 && q.z < nz {
+                // A gap ends on a piece, or under it on the table: a
+                // pillar may stand there (inside a hollow build, or in a
+                // cavity the table closes).
+                let on_table = dz < 0 && q.z < 0;
+                if (q.z >= 0 && q.z < nz) || on_table {
+                    // The inside of a hollow build under the piece becomes
+                    // a pillar: nothing else can reach the piece there once
+                    // the shell closes. Over it, the hollow stays.
+                    if dz < 0 {
+                        for &c in &col {
+                            if self.kept_empty(c) {
+                                self.released.insert(c);
+                            }
+                        }
+                    }
                     gap.extend(col);
                 }
             }

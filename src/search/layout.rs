@@ -222,6 +222,9 @@ pub(crate) struct Layout<'a> {
     pub slant: Option<&'a Slant>,
     /// Cells no piece may fill: the inside of a hollow build.
     pub keep_empty: Option<&'a VoxelGrid>,
+    /// Cells of `keep_empty` given back to the layout: an inner pillar
+    /// under a piece that could not be put in place over the hollow.
+    pub released: std::collections::HashSet<Cell>,
     /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
@@ -328,6 +331,7 @@ impl<'a> Layout<'a> {
             near,
             slant,
             keep_empty: None,
+            released: std::collections::HashSet::new(),
             colors: None,
             made,
             shapes,
@@ -359,7 +363,7 @@ impl<'a> Layout<'a> {
 
     /// Whether `c` must stay empty (the inside of a hollow build).
     pub fn kept_empty(&self, c: Cell) -> bool {
-        self.keep_empty.is_some_and(|k| k.get(c))
+        self.keep_empty.is_some_and(|k| k.get(c)) && !self.released.contains(&c)
     }
 
     /// Lays every layer, bottom first, until done or `deadline`.
@@ -629,6 +633,19 @@ impl<'a> Layout<'a> {
         body: &Body,
         reach: Reach,
     ) -> Option<(usize, usize, usize)> {
+        self.fits_within(placement, body, reach, 1)
+    }
+
+    /// [`Layout::fits`], with a slope's slant looked for as far as `depth`
+    /// layers into the model from its open cells (1 for the layout's own
+    /// candidates).
+    pub(super) fn fits_within(
+        &self,
+        placement: &Placement,
+        body: &Body,
+        reach: Reach,
+        depth: i32,
+    ) -> Option<(usize, usize, usize)> {
         let (mut inside, mut outside, mut far) = (0, 0, 0);
         // Surface voxels by colour: at most two colours, the other one at
         // most one voxel in every `COLOR_SLACK` of the main one.
@@ -670,7 +687,7 @@ impl<'a> Layout<'a> {
         if far > 0 && reach == Reach::Near {
             return None;
         }
-        if !body.is_box() && !self.face_fits(placement, body) {
+        if !body.is_box() && !self.face_fits(placement, body, depth) {
             return None;
         }
         Some((inside, outside, far))
@@ -678,9 +695,9 @@ impl<'a> Layout<'a> {
 
     /// A slope's open cells (those of its box it does not fill) are clear
     /// of the model and of pieces, and where the mesh's slant is known, it
-    /// slants there the way the slope faces (in those cells or the slope's
-    /// own cells beside them).
-    fn face_fits(&self, p: &Placement, b: &Body) -> bool {
+    /// slants there the way the slope faces (in those cells or the cells
+    /// up to `depth` layers into the model from them).
+    fn face_fits(&self, p: &Placement, b: &Body, depth: i32) -> bool {
         let open = || b.bbox.cells().filter(|&q| !b.contains(q));
         if !open().all(|q| self.free(q) && !self.must.get(q)) {
             return false;
@@ -695,7 +712,7 @@ impl<'a> Layout<'a> {
             return true;
         };
         let inward = if up { -1 } else { 1 };
-        open().any(|q| g.get(q) || g.get(q.offset(0, 0, inward)))
+        open().any(|q| (0..=depth).any(|k| g.get(q.offset(0, 0, inward * k))))
     }
 
     /// The pieces `body` rests on (their studs in its tubes), each once.

@@ -17,7 +17,10 @@
 //!    rests on nothing the rules join is joined to another by growing one of
 //!    its pieces or laying a piece across, with the fewest cells outside;
 //!    `merge` then makes neighbours whose union is a piece of the alphabet
-//!    one piece: never a seam more, always a piece fewer;
+//!    one piece: never a seam more, always a piece fewer; and `cap`, where
+//!    the alphabet has slopes, swaps the row of a brick that stands a step
+//!    above its neighbours (below, underneath) for slopes facing down the
+//!    step, so a slanted roof is capped rather than a staircase;
 //! 4. `derive`: the pieces ordered as a derivation: a starting rule, then
 //!    each piece added by the heaviest rule joining it to a piece already
 //!    there, lowest course first.
@@ -27,6 +30,7 @@
 //! tracked with a union-find.
 
 mod backward;
+mod cap;
 mod complex;
 mod derive;
 mod join;
@@ -44,7 +48,8 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::assembly::Placement;
-use crate::grammar::{RuleRef, RuleSet};
+use crate::geom::CellBox;
+use crate::grammar::{Dir, RuleRef, RuleSet};
 use crate::voxel::{Slant, VoxelGrid, Wall};
 pub use backward::{parts as hierarchy_parts, CUT_RATIO};
 pub use prepare::{components, LeftOut, Repairs};
@@ -82,6 +87,9 @@ pub struct SearchOptions {
     /// Backward tracing: cut the voxels into parts at horizontal planes
     /// (the paper's hierarchical approach). Default true.
     pub cut: bool,
+    /// Cap stair edges with slopes after the layout, where the rules have
+    /// slopes. Default `true`.
+    pub cap_stairs: bool,
 }
 
 /// Which search builds the voxels.
@@ -105,6 +113,7 @@ impl Default for SearchOptions {
             branching: (20, 150),
             node_budget: 1_000_000,
             cut: true,
+            cap_stairs: true,
         }
     }
 }
@@ -146,6 +155,12 @@ impl SearchOptions {
         self
     }
 
+    /// Sets whether stair edges are capped with slopes after the layout.
+    pub fn with_cap_stairs(mut self, cap: bool) -> Self {
+        self.cap_stairs = cap;
+        self
+    }
+
     /// Sets how often a complex rule is tested (0: never).
     pub fn with_complex_every(mut self, k: u32) -> Self {
         self.complex_every = k;
@@ -177,6 +192,9 @@ pub struct SearchStats {
     pub complex_tried: u64,
     /// Complex rules applied (each one node adding all its new pieces).
     pub complex_applied: u64,
+    /// Slopes laid after the layout to cap stair edges (inverted slopes
+    /// underneath), each in place of a brick's row along the step.
+    pub caps: u64,
     /// Whether the time budget ran out before every layer was laid.
     pub budget_hit: bool,
     /// Backward tracing: times it went back up the tree from a node with
@@ -376,24 +394,44 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
+    let swaps = if opts.cap_stairs {
+        layout.cap_stairs()
+    } else {
+        Vec::new()
+    };
     let (mut order, mut unreached) = derive::derive(&layout);
-    // A piece pressed on from below with pieces under it, too close to
-    // slide out of the way, cannot be put in place: fill the gap under it
-    // so that it rests on them instead, and derive again.
+    let mut blocked = unplaceable(&order, rules.layer_ldu());
+    // Slopes capping the stairs must not cost the build its order: if a
+    // piece cannot be put in place or reached with them, they are undone.
+    if !swaps.is_empty() && (!unreached.is_empty() || !blocked.is_empty()) {
+        layout.uncap(&swaps);
+        (order, unreached) = derive::derive(&layout);
+        blocked = unplaceable(&order, rules.layer_ldu());
+    } else {
+        layout.stats.caps = swaps.iter().map(|s| s.slopes as u64).sum();
+    }
+    // A piece that cannot be put in place at its turn goes in earlier,
+    // right after a piece it joins, while the way is still open; else the
+    // gap under it is filled so that it rests on the pieces there (inside
+    // a hollow build, a pillar), and the pieces are derived again.
     for _ in 0..PLACE_ROUNDS {
-        let blocked = unplaceable(&order, rules.layer_ldu());
         if blocked.is_empty() || Instant::now() >= deadline {
             break;
         }
+        if let Some(left) = move_earlier(&layout, &mut order, &blocked) {
+            blocked = left;
+            continue;
+        }
         let mut changed = false;
-        for p in blocked {
-            changed |= layout.fill_under(&p, &mut dice.rules);
+        for &k in &blocked {
+            changed |= layout.fill_under(&order[k].piece, &mut dice.rules);
         }
         if !changed {
             break;
         }
         layout.join(&mut dice.rules);
         (order, unreached) = derive::derive(&layout);
+        blocked = unplaceable(&order, rules.layer_ldu());
     }
     if order.is_empty() {
         if layout.stats.budget_hit {
@@ -435,22 +473,120 @@ pub fn build_guided(
     })
 }
 
-/// Rounds of filling gaps under pieces that cannot be put in place.
+/// Rounds of repairs of pieces that cannot be put in place: moves to an
+/// earlier turn, or fills of the gap under them.
 const PLACE_ROUNDS: usize = 6;
 
-/// The pieces of `order` the verifier would find cannot be put in place.
-fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<Placement> {
+/// Moves each piece of `order` at the positions `blocked`, which cannot be
+/// put in place at their turn, to the latest earlier turn where it can,
+/// right after a piece it joins by a rule (which becomes its anchor), when
+/// the whole order then has fewer pieces that cannot be put in place: the
+/// positions of those, or `None` if the order is kept.
+fn move_earlier(
+    layout: &layout::Layout,
+    order: &mut Vec<Removal>,
+    blocked: &[usize],
+) -> Option<Vec<usize>> {
+    let u = layout.layer_ldu;
+    let boxes: Vec<CellBox> = order.iter().map(|r| r.piece.body(u).bbox).collect();
+    // (from, to, the piece with its new anchor), each judged on `order`.
+    let mut moves: Vec<(usize, usize, Removal)> = Vec::new();
+    for &k in blocked {
+        let p = order[k].piece;
+        let body = p.body(u);
+        let Some(id) = layout.owner_of(body.key()) else {
+            continue;
+        };
+        let (under, over) = (layout.below(&body), layout.above(&body));
+        // Turns right after an earlier piece it joins by a rule, latest
+        // first.
+        let mut turns: Vec<(usize, Placement, RuleRef)> = Vec::new();
+        for (pos, r) in order[..k].iter().enumerate() {
+            let Some(o) = layout.owner_of(r.piece.body(u).key()) else {
+                continue;
+            };
+            let dir = if under.contains(&o) {
+                Dir::Up
+            } else if over.contains(&o) {
+                Dir::Down
+            } else {
+                continue;
+            };
+            if o == id {
+                continue;
+            }
+            if let Some((_, rule)) = layout.book.joint(&r.piece, &p, dir, u) {
+                turns.push((pos + 1, r.piece, RuleRef::Basic(rule)));
+            }
+        }
+        let Some(&(at, anchor, rule)) = turns
+            .iter()
+            .rev()
+            .find(|(at, ..)| crate::assembly::verify::placeable_after(&boxes[..*at], &body.bbox))
+        else {
+            continue;
+        };
+        if at >= k {
+            continue;
+        }
+        let mut r = order[k];
+        r.anchor = Anchor::Piece(anchor);
+        r.rule = Some(rule);
+        moves.push((k, at, r));
+    }
+    if moves.is_empty() {
+        return None;
+    }
+    // Each moved piece goes in right before the piece at its new turn
+    // (several at one turn in their old order), the rest in their order.
+    moves.sort_by_key(|&(k, at, _)| (at, k));
+    let from: std::collections::HashSet<usize> = moves.iter().map(|m| m.0).collect();
+    let mut candidate = Vec::with_capacity(order.len());
+    let mut next = moves.iter().peekable();
+    for (i, r) in order.iter().enumerate() {
+        while let Some((_, _, m)) = next.next_if(|m| m.1 == i) {
+            candidate.push(*m);
+        }
+        if !from.contains(&i) {
+            candidate.push(*r);
+        }
+    }
+    // Better only if fewer pieces are shut in and nothing else broke.
+    let (left, others) = unplaceable_and_others(&candidate, u);
+    if others > 0 || left.len() >= blocked.len() {
+        return None;
+    }
+    *order = candidate;
+    Some(left)
+}
+
+/// The positions in `order` of the pieces the verifier finds cannot be put
+/// in place at their turn.
+fn unplaceable(order: &[Removal], layer_ldu: i32) -> Vec<usize> {
+    unplaceable_and_others(order, layer_ldu).0
+}
+
+/// [`unplaceable`], and how many other failures the verifier finds (but
+/// a build in more than one part, which the derivation leaves to its
+/// caller).
+fn unplaceable_and_others(order: &[Removal], layer_ldu: i32) -> (Vec<usize>, usize) {
+    use crate::assembly::verify::Failure;
     let pieces: Vec<Placement> = order.iter().map(|r| r.piece).collect();
     let asm = crate::assembly::Assembly::from_order(&pieces, layer_ldu, crate::catalog::Color::RED);
-    crate::assembly::verify::verify(&asm, None)
+    let mut others = 0;
+    let blocked = crate::assembly::verify::verify(&asm, None)
         .failures
         .iter()
         .filter_map(|f| match f {
-            crate::assembly::verify::Failure::NotPlaceable { piece, .. }
-            | crate::assembly::verify::Failure::Enclosed { piece, .. } => Some(pieces[*piece]),
-            _ => None,
+            Failure::NotPlaceable { piece, .. } | Failure::Enclosed { piece, .. } => Some(*piece),
+            Failure::Disconnected { .. } => None,
+            _ => {
+                others += 1;
+                None
+            }
         })
-        .collect()
+        .collect();
+    (blocked, others)
 }
 
 /// The search's seeded random streams: one draws among scored candidates,

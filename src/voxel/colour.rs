@@ -85,14 +85,23 @@ pub fn color_voxels(
         .collect();
     let mut cache: HashMap<[u8; 3], Color> = HashMap::new();
     let cell = model.cell_size();
+    let frame = |t: &[u32; 3]| {
+        t.map(|i| (to_grid_frame(mesh.positions[i as usize], up) - model.origin) / cell)
+    };
+    let steps = sample_steps(
+        mesh.triangles.iter().map(|t| {
+            let p = frame(t);
+            (p[1] - p[0])
+                .length()
+                .max((p[2] - p[0]).length())
+                .max((p[2] - p[1]).length())
+        }),
+        sample_budget(grid.count()),
+    );
     let mut votes: Vec<(u32, Color, u32)> = Vec::new();
     for (k, t) in mesh.triangles.iter().enumerate() {
-        let p = t.map(|i| (to_grid_frame(mesh.positions[i as usize], up) - model.origin) / cell);
-        let span = (p[1] - p[0])
-            .length()
-            .max((p[2] - p[0]).length())
-            .max((p[2] - p[1]).length());
-        let steps = (span * 3.0).ceil().clamp(1.0, 4096.0) as usize;
+        let p = frame(t);
+        let steps = steps[k] as usize;
         // A sample on a cell boundary (a face flush with the grid) belongs
         // to the cell behind the face: step a hair inward.
         let inward = -(p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero() * 0.01;
@@ -165,6 +174,46 @@ pub fn color_voxels(
         used,
         limited,
     })
+}
+
+/// The most surface samples [`color_voxels`] takes in all, for a grid of
+/// `voxels` filled cells: 8 million, or 8 a voxel for a larger model
+/// (every triangle still gets its three samples of one step). Without a
+/// budget, a small file repeating one large triangle 10,000 times asked for
+/// hundreds of millions of samples.
+fn sample_budget(voxels: usize) -> u64 {
+    (1u64 << 23).max(8 * voxels as u64)
+}
+
+/// Samples along each side of each triangle (the sample count of a
+/// triangle is `(s + 1)(s + 2) / 2` for `s` steps): every third of a cell
+/// over its longest side (`spans`, in cells), at most 4096; then, if the
+/// total passes `budget`, every triangle's steps scaled down alike (at
+/// least 1) until it is under, so the total stays at most the budget (or
+/// one step a triangle) whatever the file repeats.
+fn sample_steps(spans: impl Iterator<Item = f32>, budget: u64) -> Vec<u16> {
+    let mut steps: Vec<u16> = spans
+        .map(|span| (span * 3.0).ceil().clamp(1.0, 4096.0) as u16)
+        .collect();
+    let count = |s: u16| (u64::from(s) + 1) * (u64::from(s) + 2) / 2;
+    let total: u64 = steps.iter().map(|&s| count(s)).sum();
+    if total > budget {
+        let full = steps.clone();
+        let mut f = (budget as f64 / total as f64).sqrt();
+        // The counts' linear terms can leave the first guess a little over:
+        // shrink on until under (or every triangle is at one step).
+        loop {
+            for (s, &n) in steps.iter_mut().zip(&full) {
+                *s = ((f64::from(n) * f).floor() as u16).max(1);
+            }
+            let now: u64 = steps.iter().map(|&s| count(s)).sum();
+            if now <= budget || steps.iter().all(|&s| s == 1) {
+                break;
+            }
+            f *= 0.97;
+        }
+    }
+    steps
 }
 
 /// Gives every filled cell the colour of the nearest coloured cell (a
@@ -241,4 +290,35 @@ fn count(cells: &[Option<Color>], surface: &[bool]) -> Vec<(Color, usize)> {
     let mut v: Vec<(Color, usize)> = m.into_iter().collect();
     v.sort_by_key(|&(c, n)| (std::cmp::Reverse(n), c));
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sample_steps;
+
+    fn samples(steps: &[u16]) -> u64 {
+        steps
+            .iter()
+            .map(|&s| (u64::from(s) + 1) * (u64::from(s) + 2) / 2)
+            .sum()
+    }
+
+    #[test]
+    fn samples_stay_under_the_budget_however_often_a_triangle_repeats() {
+        // One triangle 200 cells across, 10,000 times (issue 30, finding 4):
+        // 181 million samples unbounded.
+        let spans = std::iter::repeat_n(200.0f32, 10_000);
+        let steps = sample_steps(spans, 1 << 23);
+        let n = samples(&steps);
+        assert!(n <= 1 << 23, "{n}");
+        assert!(n > 1 << 22, "the budget is used, not starved: {n}");
+        // Under the budget nothing changes: every third of a cell.
+        assert_eq!(
+            sample_steps([0.1f32, 2.0, 10.0].into_iter(), 1 << 23),
+            vec![1, 6, 30]
+        );
+        // Tiny triangles past the budget keep one step each.
+        let tiny = sample_steps(std::iter::repeat_n(0.2f32, 100), 10);
+        assert!(tiny.iter().all(|&s| s == 1));
+    }
 }

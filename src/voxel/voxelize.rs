@@ -85,8 +85,13 @@ pub const LAYER_HEIGHT_STUDS: f32 = 1.2;
 /// The most cells [`voxelize`] makes along any one axis.
 pub const MAX_SIDE: u32 = 512;
 
-/// The most cells [`voxelize`] makes in all (2^27, 16 MiB of bits).
-pub const MAX_CELLS: u64 = 1 << 27;
+/// The most cells [`voxelize`] makes in all, filled or not (2^24, about
+/// 16.8 million): the stages after it (colours, layout, the checks) take
+/// time and memory with the grid's cells, not only its voxels, so a thin
+/// diagonal rod of a few thousand voxels at 512 studs (512 x 512 x 425
+/// cells) took 46 s and 1.2 GB. A solid model that large would pass the
+/// search's voxel limit anyway; this bounds the sparse ones.
+pub const MAX_CELLS: u64 = 1 << 24;
 
 /// Which input axis points up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -307,7 +312,7 @@ pub enum VoxelizeError {
     /// The grid would be too big.
     #[error(
         "the model would be {nx} x {ny} x {nz} cells, beyond the limit of {MAX_SIDE} a side \
-         and {MAX_CELLS} in all; ask for fewer studs or layers"
+         and {MAX_CELLS} in all; ask for a smaller size: fewer studs (--studs) or layers (--height)"
     )]
     TooLarge {
         /// Cells along x.

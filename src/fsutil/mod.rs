@@ -1,10 +1,16 @@
 //! Atomic file output: write to a temporary file beside the target, then
-//! rename, so a failed run never leaves a half-written file behind.
+//! rename, so a failed run never leaves a half-written file behind; and a
+//! run's many outputs put in place all or none, even when interrupted
+//! ([`Outputs`], see [`stage`]).
 
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use tempfile::{NamedTempFile, TempPath};
+use tempfile::NamedTempFile;
+
+pub mod stage;
+
+pub use stage::{interrupted, recover, Outputs};
 
 /// Writes `path` atomically: `fill` writes the whole content into a temporary
 /// file in the same directory, which is renamed over `path` only on success.
@@ -13,110 +19,10 @@ where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
     let tmp = staged(path, fill)?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
-}
-
-/// Several outputs written all or none: each is filled into a temporary
-/// file beside its target as it is [added](Outputs::add), and only
-/// [`commit`](Outputs::commit) renames them into place. Dropped without a
-/// commit (an error on the way), it leaves nothing behind.
-#[derive(Default)]
-pub struct Outputs {
-    staged: Vec<(PathBuf, NamedTempFile)>,
-}
-
-impl Outputs {
-    /// No outputs yet.
-    pub fn new() -> Self {
-        Outputs::default()
-    }
-
-    /// Fills the content of `path`; the file appears at commit.
-    pub fn add<F>(&mut self, path: &Path, fill: F) -> io::Result<()>
-    where
-        F: FnOnce(&mut dyn Write) -> io::Result<()>,
-    {
-        let tmp = staged(path, fill)?;
-        self.staged.push((path.to_path_buf(), tmp));
-        Ok(())
-    }
-
-    /// The paths added so far, in order.
-    pub fn paths(&self) -> impl Iterator<Item = &Path> {
-        self.staged.iter().map(|(p, _)| p.as_path())
-    }
-
-    /// Renames every staged file into place, all or none: a target that
-    /// is a directory fails before anything moves, each file already there
-    /// is moved aside first, and on any failure the new files are taken
-    /// away and the old ones put back. On an error, the path that failed
-    /// comes with it.
-    pub fn commit(self) -> Result<(), (PathBuf, io::Error)> {
-        self.commit_with(|tmp, path| tmp.persist(path).map(drop).map_err(|e| e.error))
-    }
-
-    /// [`Outputs::commit`], each file put in place by `place` (a test
-    /// makes it fail halfway).
-    fn commit_with(
-        self,
-        mut place: impl FnMut(NamedTempFile, &Path) -> io::Result<()>,
-    ) -> Result<(), (PathBuf, io::Error)> {
-        for (path, _) in &self.staged {
-            if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir()) {
-                return Err((
-                    path.clone(),
-                    io::Error::new(io::ErrorKind::IsADirectory, "a directory is in the way"),
-                ));
-            }
-        }
-        // What was done, to undo: (target, the old file moved aside).
-        let mut placed: Vec<(PathBuf, Option<TempPath>)> = Vec::new();
-        for (path, tmp) in self.staged {
-            let step = move_aside(&path).and_then(|old| match place(tmp, &path) {
-                Ok(()) => Ok(old),
-                Err(e) => {
-                    if let Some(old) = &old {
-                        let _ = std::fs::rename(old, &path);
-                    }
-                    Err(e)
-                }
-            });
-            match step {
-                Ok(old) => placed.push((path, old)),
-                Err(e) => {
-                    for (done, old) in placed.into_iter().rev() {
-                        match old {
-                            Some(old) => {
-                                let _ = std::fs::rename(&old, &done);
-                            }
-                            None => {
-                                let _ = std::fs::remove_file(&done);
-                            }
-                        }
-                    }
-                    return Err((path, e));
-                }
-            }
-        }
-        // Success: the old files moved aside are deleted as they drop.
-        Ok(())
-    }
-}
-
-/// Moves the file at `path`, if any, to a fresh temporary name beside it
-/// (deleted when the returned path drops).
-fn move_aside(path: &Path) -> io::Result<Option<TempPath>> {
-    if std::fs::symlink_metadata(path).is_err() {
-        return Ok(None);
-    }
-    let old = tempfile::Builder::new()
-        .prefix(".brickwright-")
-        .suffix(".old")
-        .tempfile_in(parent_dir(path))?
-        .into_temp_path();
-    std::fs::rename(path, &old)?;
-    Ok(Some(old))
+    let at = tmp.path().to_path_buf();
+    let placed = tmp.persist(path).map(drop).map_err(|e| e.error);
+    stage::forget(&at);
+    placed
 }
 
 /// The directory `path` is in (`.` for a bare file name).
@@ -152,6 +58,10 @@ impl CreatedDirs {
             }
         }
         std::fs::create_dir_all(dir)?;
+        // Removed on Ctrl-C too, innermost first.
+        for d in missing.iter().rev() {
+            stage::created_dir(d);
+        }
         // Innermost first, the order they are removed in.
         self.dirs.extend(missing);
         Ok(())
@@ -159,13 +69,16 @@ impl CreatedDirs {
 
     /// The run succeeded: keep them.
     pub fn keep(mut self) {
-        self.dirs.clear();
+        for d in self.dirs.drain(..) {
+            stage::forget(&d);
+        }
     }
 }
 
 impl Drop for CreatedDirs {
     fn drop(&mut self) {
         for d in &self.dirs {
+            stage::forget(d);
             // Only an empty directory goes; anything else stays.
             let _ = std::fs::remove_dir(d);
         }
@@ -193,10 +106,16 @@ where
         .prefix(".brickwright-")
         .suffix(".part")
         .tempfile_in(dir)?;
-    {
+    // Removed on Ctrl-C; dropped on an error, it goes by itself.
+    stage::temp_file(tmp.path());
+    let filled = (|| {
         let mut w = BufWriter::new(tmp.as_file());
         fill(&mut w)?;
-        w.flush()?;
+        w.flush()
+    })();
+    if let Err(e) = filled {
+        stage::forget(tmp.path());
+        return Err(e);
     }
     // No fsync: the rename makes the file appear whole or not at all if
     // the process fails; syncing every file (hundreds of step images)
@@ -239,13 +158,13 @@ mod tests {
     fn outputs_appear_all_together_or_not_at_all() {
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.txt"), dir.path().join("b.txt"));
-        let mut out = Outputs::new();
+        let mut out = Outputs::new(dir.path()).unwrap();
         out.add(&a, |w| w.write_all(b"a")).unwrap();
         assert!(!a.exists());
         assert!(out.add(&b, |_| Err(io::Error::other("boom"))).is_err());
         drop(out);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-        let mut out = Outputs::new();
+        let mut out = Outputs::new(dir.path()).unwrap();
         out.add(&a, |w| w.write_all(b"a")).unwrap();
         out.add(&b, |w| w.write_all(b"b")).unwrap();
         assert_eq!(out.paths().count(), 2);
@@ -265,7 +184,7 @@ mod tests {
         std::fs::write(&a, "old ldr").unwrap();
         std::fs::write(&c, "old report").unwrap();
         std::fs::create_dir(&b).unwrap();
-        let mut out = Outputs::new();
+        let mut out = Outputs::new(dir.path()).unwrap();
         for p in [&a, &b, &c] {
             out.add(p, |w| w.write_all(b"new")).unwrap();
         }
@@ -283,19 +202,19 @@ mod tests {
         let [a, b, c] = ["a.txt", "b.txt", "c.txt"].map(|n| dir.path().join(n));
         std::fs::write(&a, "old a").unwrap();
         std::fs::write(&c, "old c").unwrap();
-        let mut out = Outputs::new();
+        let mut out = Outputs::new(dir.path()).unwrap();
         for p in [&a, &b, &c] {
             out.add(p, |w| w.write_all(b"new")).unwrap();
         }
         // The third file fails to go in place, after two have.
         let mut n = 0;
         let (at, _) = out
-            .commit_with(|tmp, path| {
+            .commit_with(|from, to| {
                 n += 1;
                 if n == 3 {
                     return Err(io::Error::other("disk full"));
                 }
-                tmp.persist(path).map(drop).map_err(|e| e.error)
+                std::fs::rename(from, to)
             })
             .unwrap_err();
         assert_eq!(at, c);
@@ -303,6 +222,68 @@ mod tests {
         assert!(!b.exists());
         assert_eq!(std::fs::read_to_string(&c).unwrap(), "old c");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    /// Interrupted before its renames began, a write leaves the old
+    /// outputs; after, the next run finishes it. Either way no staging
+    /// folder stays.
+    #[test]
+    fn an_interrupted_write_is_undone_or_finished_by_the_next_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let [a, b] = ["a.txt", "steps/b.txt"].map(|n| dir.path().join(n));
+        std::fs::create_dir(dir.path().join("steps")).unwrap();
+        std::fs::write(&a, "old a").unwrap();
+        std::fs::write(&b, "old b").unwrap();
+        let leftovers = |d: &Path| {
+            std::fs::read_dir(d)
+                .unwrap()
+                .filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .file_name()
+                        .to_string_lossy()
+                        .starts_with(".brickwright")
+                })
+                .count()
+        };
+        // Killed while staging: the folder is there, no mark.
+        let mut out = Outputs::new(dir.path()).unwrap();
+        out.add(&a, |w| w.write_all(b"new a")).unwrap();
+        out.add(&b, |w| w.write_all(b"new b")).unwrap();
+        out.kill();
+        assert_eq!(leftovers(dir.path()), 1);
+        recover(dir.path()).unwrap();
+        assert_eq!(leftovers(dir.path()), 0);
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a");
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "old b");
+        // Killed after the first rename: the mark is there.
+        let mut out = Outputs::new(dir.path()).unwrap();
+        out.add(&a, |w| w.write_all(b"new a")).unwrap();
+        out.add(&b, |w| w.write_all(b"new b")).unwrap();
+        let stage = out.kill();
+        std::fs::write(stage.join("commit"), "").unwrap();
+        std::fs::rename(&a, stage.join("old-a")).unwrap();
+        std::fs::rename(stage.join("new/a.txt"), &a).unwrap();
+        recover(dir.path()).unwrap();
+        assert_eq!(leftovers(dir.path()), 0);
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new a");
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "new b");
+        assert_eq!(leftovers(&dir.path().join("steps")), 0);
+    }
+
+    #[test]
+    fn a_running_writers_stage_is_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.txt");
+        let mut out = Outputs::new(dir.path()).unwrap();
+        out.add(&a, |w| w.write_all(b"a")).unwrap();
+        // Another run into the same folder, meanwhile.
+        let mut other = Outputs::new(dir.path()).unwrap();
+        other.add(&a, |w| w.write_all(b"b")).unwrap();
+        other.commit().unwrap();
+        out.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "a");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

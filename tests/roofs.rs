@@ -1,0 +1,152 @@
+//! Roofs capped with slopes: with slopes in the alphabet, the stair edges
+//! of a pitched roof carry slopes facing down the step, and nothing of the
+//! build is lost for it.
+
+use std::path::Path;
+
+use brickwright::assembly::{stairs, verify::verify, Assembly};
+use brickwright::catalog::{Color, Family, Shape};
+use brickwright::grammar::{default_rules, RuleSet};
+use brickwright::search::{self, Guide, SearchOptions};
+use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
+
+fn rules(slopes: bool) -> RuleSet {
+    default_rules()
+        .restricted(|p| {
+            p.spec().family() != Family::Plate && (slopes || p.spec().family() == Family::Brick)
+        })
+        .unwrap()
+}
+
+/// Builds the mesh at `path` `studs` across, checks it, and returns it.
+fn build(path: &Path, studs: u32, slopes: bool) -> Assembly {
+    let rules = rules(slopes);
+    let mesh = brickwright::mesh::load(path).unwrap();
+    let vopts = VoxelizeOptions::default()
+        .with_sizing(Sizing::Studs(studs))
+        .with_layer_ldu(rules.layer_ldu());
+    let model = voxelize(&mesh, &vopts).unwrap();
+    let guide = Guide {
+        slant: Some(&model.slant),
+        surface: Some(&model.surface),
+        ..Default::default()
+    };
+    let out = search::build_guided(&model.grid, guide, &rules, &SearchOptions::default()).unwrap();
+    let asm = Assembly::from_order(&search::placements(&out), rules.layer_ldu(), Color::RED);
+    let report = verify(&asm, Some(&out.voxels));
+    assert!(report.is_ok(), "{}: {report}", path.display());
+    // The whole shape: every voxel of the model built.
+    for c in model.grid.cells() {
+        assert!(
+            out.voxels.get(c),
+            "{}: voxel {c:?} left out",
+            path.display()
+        );
+    }
+    assert_eq!(out.repairs.left_out, 0);
+    asm
+}
+
+/// A gable-roofed house, `w` wide, `l` long, walls `h` high and the ridge
+/// `r` above them, as OBJ text (y up).
+fn gable_house(w: f64, l: f64, h: f64, r: f64) -> String {
+    let v = [
+        (0.0, 0.0, 0.0),
+        (w, 0.0, 0.0),
+        (w, h, 0.0),
+        (w / 2.0, h + r, 0.0),
+        (0.0, h, 0.0),
+        (0.0, 0.0, l),
+        (w, 0.0, l),
+        (w, h, l),
+        (w / 2.0, h + r, l),
+        (0.0, h, l),
+    ];
+    // Gable ends (pentagons as fans), walls, roof planes, floor.
+    let faces: [&[usize]; 7] = [
+        &[1, 5, 4, 3, 2],
+        &[6, 7, 8, 9, 10],
+        &[1, 2, 7, 6],
+        &[5, 10, 9, 4],
+        &[2, 3, 8, 7],
+        &[3, 4, 9, 8],
+        &[1, 6, 10, 5],
+    ];
+    let mut obj = String::from("o gable\n");
+    for (x, y, z) in v {
+        obj += &format!("v {x} {y} {z}\n");
+    }
+    for f in faces {
+        for k in 1..f.len() - 1 {
+            obj += &format!("f {} {} {}\n", f[0], f[k], f[k + 1]);
+        }
+    }
+    obj
+}
+
+fn slopes(asm: &Assembly) -> usize {
+    asm.pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().shape == Shape::Slope)
+        .count()
+}
+
+fn share_1x1(asm: &Assembly) -> f64 {
+    let n = asm
+        .pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().studs() == 1)
+        .count();
+    n as f64 / asm.pieces.len() as f64
+}
+
+/// Checks a roof built with slopes against the same mesh built of bricks.
+fn check_roof(path: &Path, studs: u32, min_share: f64) {
+    let plain = build(path, studs, false);
+    let sloped = build(path, studs, true);
+    let plain_stairs = stairs::stair_edges(&plain);
+    let s = stairs::stair_edges(&sloped);
+    assert!(s.edges.top > 20, "{}: {s:?}", path.display());
+    assert!(
+        s.top_share() >= min_share,
+        "{}: {} of {} stair edges capped",
+        path.display(),
+        s.capped.top,
+        s.edges.top
+    );
+    assert_eq!(plain_stairs.capped.top, 0, "bricks cap nothing");
+    assert!(slopes(&sloped) >= 10, "{} slopes", slopes(&sloped));
+    // Nothing lost: about as much built a piece as with bricks alone (with
+    // slopes a layer is half a brick, so a brick is twice the voxels), and
+    // no more 1x1s.
+    let vpp = |a: &Assembly, per_brick: i32| {
+        let cells: i32 = a
+            .pieces
+            .iter()
+            .map(|p| p.placement.body(a.layer_ldu).volume())
+            .sum();
+        f64::from(cells) / f64::from(per_brick) / a.pieces.len() as f64
+    };
+    let (p, q) = (vpp(&plain, 1), vpp(&sloped, 2));
+    assert!(
+        q >= 0.85 * p,
+        "{}: {q:.2} bricks a piece against {p:.2}",
+        path.display()
+    );
+    assert!(share_1x1(&sloped) <= share_1x1(&plain) + 0.02);
+}
+
+#[test]
+fn the_house_fixture_roof_is_capped() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
+    check_roof(&path, 24, 0.75);
+}
+
+#[test]
+fn a_shallow_gable_roof_is_capped() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gable.obj");
+    // Walls 3 high, the ridge 2.4 above them over a 4-unit run: about 31°.
+    std::fs::write(&path, gable_house(8.0, 10.0, 3.0, 2.4)).unwrap();
+    check_roof(&path, 20, 0.5);
+}
