@@ -27,6 +27,7 @@
 //! no child left is
 //! backtracked from.
 
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::hash::{Hash, Hasher};
 use std::time::Instant;
@@ -100,8 +101,11 @@ struct Frame {
     /// The change that made this node from its parent.
     change: Option<Change>,
     /// Whether every rule that could match is among `tries` (`b` was no
-    /// smaller than their number): only then is a failure here final.
+    /// smaller than their number).
     complete: bool,
+    /// Whether every child's subtree was searched whole (each of its nodes
+    /// `complete`): only a node complete and whole has failed for good.
+    whole: bool,
 }
 
 /// A part being traced.
@@ -125,10 +129,19 @@ pub(super) struct Trace<'a> {
     /// rule; the others' a rule joining it to the parts below).
     first: bool,
     /// What is built when a piece of this part goes in: what is left of
-    /// it, and the parts below.
-    built: VoxelGrid,
+    /// it, and the parts below (a scratch copy the flood fill empties a
+    /// piece's cells in, and fills again).
+    built: RefCell<VoxelGrid>,
+    /// Shapes of the alphabet's pieces, each turn: what can cover a cell.
+    shapes: Vec<Body>,
+    /// How many times wider `b` is than tuned: doubled each time a pass
+    /// of the tree that tried only `b` rules at some node comes back with
+    /// nothing, until every rule is tried at every node.
+    widen: u32,
     hash: u64,
     failed: HashSet<u64>,
+    /// Whether the last pass's root was complete and whole.
+    last_pass_whole: bool,
     /// For each applied change, which of its taken pieces were pending.
     were_log: Vec<Vec<bool>>,
 }
@@ -171,14 +184,24 @@ impl<'a> Trace<'a> {
             taken: Vec::new(),
             below_pieces,
             first,
-            built,
+            built: RefCell::new(built),
+            shapes: coverers(rules),
+            widen: 1,
             hash: 0,
             failed: HashSet::new(),
+            last_pass_whole: false,
             were_log: Vec::new(),
         }
     }
 
     /// Traces the part; its derivation in forward order.
+    ///
+    /// The tree is searched in passes. A node tries the `b` rules drawn
+    /// first; when a pass comes back to the root with nothing and some
+    /// node tried fewer than all its rules, `b` is doubled and the tree
+    /// searched again (what failed for good is remembered, so a pass
+    /// repeats little). Only a pass in which every node tried every rule
+    /// proves the rules cannot build the part.
     pub fn run(
         &mut self,
         rng: &mut ChaCha8Rng,
@@ -187,12 +210,31 @@ impl<'a> Trace<'a> {
         if let Some(r) = self.single_piece() {
             return Ok(vec![r]);
         }
+        let all = self.rules.variants().len() as u32;
+        loop {
+            if let Some(d) = self.pass(rng, count)? {
+                return Ok(d);
+            }
+            if self.last_pass_whole || self.tuning.b_min.max(1) * self.widen > all {
+                return Err(Stop::Exhausted);
+            }
+            self.widen *= 2;
+        }
+    }
+
+    /// One pass of the depth-first tree: a derivation, or `None` when the
+    /// root has no child left (`last_pass_whole` says whether for good).
+    fn pass(
+        &mut self,
+        rng: &mut ChaCha8Rng,
+        count: &mut Counters,
+    ) -> Result<Option<Vec<Removal>>, Stop> {
         let mut log: Vec<Change> = Vec::new();
         let root = self.frame(rng, count, None);
         let mut stack = vec![root];
         loop {
             if let Some(last) = self.finished() {
-                return Ok(self.derivation(&log, last));
+                return Ok(Some(self.derivation(&log, last)));
             }
             if count.nodes >= self.tuning.node_budget {
                 return Err(Stop::Nodes);
@@ -201,7 +243,7 @@ impl<'a> Trace<'a> {
                 return Err(Stop::Time);
             }
             let Some(top) = stack.last_mut() else {
-                return Err(Stop::Exhausted);
+                return Ok(None);
             };
             let mut child = None;
             while top.next < top.tries.len() && child.is_none() {
@@ -231,7 +273,7 @@ impl<'a> Trace<'a> {
                 Some(c) => {
                     count.nodes += 1;
                     self.apply(&c);
-                    if self.failed.contains(&self.hash) || !self.connected() {
+                    if self.failed.contains(&self.hash) || !self.connected() || !self.coverable() {
                         self.undo(&c);
                         continue;
                     }
@@ -245,10 +287,15 @@ impl<'a> Trace<'a> {
                 None => {
                     // Every rule tried: back up.
                     let done = stack.pop().expect("a frame is on the stack");
-                    // A node that tried only `b` of its rules may succeed
-                    // with another draw when it is met again.
-                    if done.complete {
+                    // A node that tried only `b` of its rules, or under
+                    // which one did, may succeed when met again.
+                    let whole = done.complete && done.whole;
+                    if whole {
                         self.failed.insert(self.hash);
+                    }
+                    match stack.last_mut() {
+                        Some(parent) => parent.whole &= whole,
+                        None => self.last_pass_whole = whole,
                     }
                     if let Some(c) = done.change {
                         count.backtracks += 1;
@@ -266,7 +313,7 @@ impl<'a> Trace<'a> {
         let t = &self.tuning;
         let done = 1.0 - self.left_count as f64 / self.total.max(1) as f64;
         let b = t.b_min as f64 + (t.b_max.saturating_sub(t.b_min)) as f64 * done;
-        let b = b.round() as usize;
+        let b = (b.round() as usize).saturating_mul(self.widen as usize);
         // Only rules whose new piece fits somewhere it may go can match.
         let mut shapes: Vec<(PartKind, Rot)> = self
             .rules
@@ -320,6 +367,7 @@ impl<'a> Trace<'a> {
             spots,
             change,
             complete,
+            whole: true,
         }
     }
 
@@ -392,12 +440,17 @@ impl<'a> Trace<'a> {
     /// what is left of the part besides `b`, and the parts below, leave it
     /// a way in.
     fn can_place(&self, b: &Body, also_gone: &[Body], from_above: bool) -> bool {
-        let mut solid = self.built.clone();
+        let mut solid = self.built.borrow_mut();
         solid.set_body(b, false);
         for g in also_gone {
             solid.set_body(g, false);
         }
-        placeable(&b.bbox, &solid, from_above)
+        let ok = placeable(&b.bbox, &solid, from_above);
+        solid.set_body(b, true);
+        for g in also_gone {
+            solid.set_body(g, true);
+        }
+        ok
     }
 
     /// The first match of basic variant `v` in its scan direction.
@@ -554,7 +607,7 @@ impl<'a> Trace<'a> {
             }
             were.push(was);
             self.left.set_body(&b, false);
-            self.built.set_body(&b, false);
+            self.built.get_mut().set_body(&b, false);
             self.left_count -= b.volume() as usize;
             self.taken.push(*p);
             self.hash ^= piece_hash(p, 2);
@@ -570,7 +623,7 @@ impl<'a> Trace<'a> {
             self.taken.pop();
             self.hash ^= piece_hash(p, 2);
             self.left.set_body(&b, true);
-            self.built.set_body(&b, true);
+            self.built.get_mut().set_body(&b, true);
             self.left_count += b.volume() as usize;
             if was {
                 self.pending.push(*p);
@@ -586,18 +639,30 @@ impl<'a> Trace<'a> {
         }
     }
 
-    /// Whether what is left is one piece (face to face): a derivation's
-    /// every shape is.
+    /// Whether what is left can still be one shape held together by
+    /// studs, as every shape of a derivation is: its cells joined through
+    /// cells above or below one another (a stud joint, or a tall piece),
+    /// or side by side where one piece may hold both (two free cells, or
+    /// two cells of the same matched piece). Side by side cells of two
+    /// pieces do not hold each other.
     fn connected(&self) -> bool {
         let Some(start) = self.left.cells().next() else {
             return true;
         };
-        let mut seen = VoxelGrid::new(self.left.dims().0, self.left.dims().1, self.left.dims().2);
+        let owner = |c: Cell| -> Option<usize> {
+            if !self.held.get(c) {
+                return None;
+            }
+            self.pending.iter().position(|p| self.body(p).contains(c))
+        };
+        let (nx, ny, nz) = self.left.dims();
+        let mut seen = VoxelGrid::new(nx, ny, nz);
         let mut stack = vec![start];
         seen.set(start, true);
         let mut n = 0usize;
         while let Some(c) = stack.pop() {
             n += 1;
+            let mine = owner(c);
             for (dx, dy, dz) in [
                 (1, 0, 0),
                 (-1, 0, 0),
@@ -607,13 +672,35 @@ impl<'a> Trace<'a> {
                 (0, 0, -1),
             ] {
                 let d = c.offset(dx, dy, dz);
-                if self.left.in_bounds(d) && self.left.get(d) && !seen.get(d) {
-                    seen.set(d, true);
-                    stack.push(d);
+                if !self.left.in_bounds(d) || !self.left.get(d) || seen.get(d) {
+                    continue;
                 }
+                if dz == 0 && owner(d) != mine {
+                    continue;
+                }
+                seen.set(d, true);
+                stack.push(d);
             }
         }
         n == self.left_count
+    }
+
+    /// Whether every free cell (left, and no matched piece's) is a cell of
+    /// some piece of the alphabet whose cells are all free: the piece that
+    /// will be taken away with it. A cell no piece can cover is a dead end.
+    fn coverable(&self) -> bool {
+        if self.shapes.iter().any(|s| s.volume() == 1) {
+            return true;
+        }
+        self.left.cells().filter(|&c| !self.held.get(c)).all(|c| {
+            self.shapes.iter().any(|s| {
+                let k = s.cells().collect::<Vec<_>>();
+                k.iter().any(|q| {
+                    let b = s.moved(c.x - q.x, c.y - q.y, c.z - q.z);
+                    self.free(&b)
+                })
+            })
+        })
     }
 
     /// The last piece, if the trace is done: one pending piece is all that
@@ -686,7 +773,25 @@ impl<'a> Trace<'a> {
     }
 }
 
+/// The bodies of the alphabet's pieces at the origin, every distinct turn.
+fn coverers(rules: &RuleSet) -> Vec<Body> {
+    let mut out: Vec<Body> = Vec::new();
+    for &part in rules.alphabet() {
+        for rot in Rot::ALL {
+            let b = Placement::new(part, Cell::new(0, 0, 0), rot).body(rules.layer_ldu());
+            if !out.contains(&b) {
+                out.push(b);
+            }
+        }
+    }
+    out
+}
+
 /// The pieces of a derivation, by placement: for the parts above.
 pub(super) fn pieces(order: &[Removal]) -> Vec<Placement> {
     order.iter().map(|r| r.piece).collect()
 }
+
+#[cfg(test)]
+#[path = "trace_tests.rs"]
+mod tests;
