@@ -112,6 +112,15 @@ fn figure5_traces_back_to_a_starting_rule_and_replays_forward() {
         replay(&out, &rules, &shape);
         let d = Derivation::of(&out.order, &rules);
         assert_eq!(d.forward.len(), 12, "seed {seed}: {:?}", d.backward);
+        // Printed as the paper prints Figure 5's backward order.
+        let printed = d.paper();
+        println!("seed {seed}: backward order {printed}");
+        assert!(printed.starts_with('{') && printed.ends_with('}'));
+        assert_eq!(printed.matches(',').count(), 11, "{printed}");
+        assert!(
+            printed.ends_with(",0}") || printed.ends_with(",1}"),
+            "{printed}"
+        );
         // The backward order ends in a starting rule (0 or 1), as the
         // paper's {10,5,6,5,8,9,3,2,2,5,5,0} does, and every other number
         // is a basic rule of the figure.

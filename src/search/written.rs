@@ -60,6 +60,12 @@ pub const NUMBERING: &str =
     "from 0: the start rules, then the basic rules (the file's `rule` lines, then those `unseen` adds), then the complex rules, each in file order";
 
 impl Derivation {
+    /// The backward order as the paper prints it: `{10,5,6,5,8,9,3,2,2,5,5,0}`.
+    pub fn paper(&self) -> String {
+        let n: Vec<String> = self.backward.iter().map(u32::to_string).collect();
+        format!("{{{}}}", n.join(","))
+    }
+
     /// The derivation of `order`, whose rules refer to `rules`.
     pub fn of(order: &[Removal], rules: &RuleSet) -> Derivation {
         let numbers = rules.numbers();
