@@ -10,6 +10,7 @@
 
 mod common;
 
+mod backward;
 mod booklet;
 mod cli;
 mod colours;

@@ -19,6 +19,7 @@ fn meta(name: &str) -> LdrMeta {
         author: "brickwright tests".into(),
         notes: vec!["brickwright 0.1.0".into(), "seed 7".into()],
         step_notes: Default::default(),
+        piece_notes: Default::default(),
     }
 }
 
@@ -153,6 +154,7 @@ fn golden_small_ldr() {
             "hand-made: two 2x4s, a 1x4, a 2x2".into(),
         ],
         step_notes: Default::default(),
+        piece_notes: Default::default(),
     };
     write_ldr(&mut out, &golden_assembly(), &meta).unwrap();
     let text = String::from_utf8(out).unwrap();

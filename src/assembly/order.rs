@@ -2,8 +2,10 @@
 //! like instructions.
 //!
 //! The search's trace is a valid build order, but it can move up and down
-//! between brick courses (a hierarchy part spans several courses, and the
-//! backward tracing peels pieces wherever a rule matched). A person builds
+//! between brick courses (the layout's derivation takes a piece hanging
+//! under an overhang right after the piece it hangs from, and
+//! `--search backward`'s derivation adds pieces in the reverse of the order
+//! its trace took them away, wherever a rule matched). A person builds
 //! a course, then the next; instructions that jump between courses make
 //! many tiny steps. [`by_course`] re-sequences the same pieces greedily:
 //! at each turn it adds, among the pieces on the ground or stud-connected

@@ -138,6 +138,15 @@ pub enum StepBy {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+pub enum SearchArg {
+    /// The forward layout, course by course (fast, keeps the whole shape).
+    Layout,
+    /// The paper's backward tracing of the rules (section 4), with backtracking; fails
+    /// (exit 2, no files) when the rules cannot build the shape within the budgets.
+    Backward,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 pub enum StabilityArg {
     /// Check every step and fix what fails.
     Repair,
@@ -188,7 +197,8 @@ pub struct BuildArgs {
     /// Which axis of the input points up.
     #[arg(long, value_enum, default_value_t = UpAxis::Y)]
     pub up: UpAxis,
-    /// Seed for the search's rule sampling: the same input, options and seed give the same files.
+    /// Seed of the search's random draws (the layout's among near-equal pieces, the backward
+    /// search's rule sampling): the same input, options and seed give the same files.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// A rule file (see rules/default.rules); default: the built-in default rules.
@@ -207,6 +217,12 @@ pub struct BuildArgs {
     /// Group steps another way.
     #[arg(long, value_enum)]
     pub step_by: Option<StepBy>,
+    /// The search: layout (default) or backward (the paper's backward tracing).
+    #[arg(long, value_enum, default_value_t = SearchArg::Layout)]
+    pub search: SearchArg,
+    /// With --search backward, give up after this many tree nodes.
+    #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub node_budget: u64,
     /// Test a complex rule (several pieces at once) once every K search nodes (the paper: 1 to 5); 0 never.
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub complex_every: u32,
@@ -325,6 +341,11 @@ impl BuildArgs {
             .with_seed(a.seed)
             .with_time_budget(time_budget)
             .with_complex_every(a.complex_every)
+            .with_method(match a.search {
+                SearchArg::Layout => brickwright::search::Method::Layout,
+                SearchArg::Backward => brickwright::search::Method::Backward,
+            })
+            .with_node_budget(a.node_budget)
             .with_hollow(brickwright::voxel::Wall::new(a.wall).filter(|_| a.hollow));
         Ok(opts)
     }

@@ -74,6 +74,9 @@ use crate::ldraw::{layer_ldu_of, read_ldr, to_placement, LdrError, LdrModel};
 /// highest count.
 pub const PAPER_FIGURES: (u64, u64, u64, u64) = (223, 2484, 1, 139);
 
+/// How many skipped parts the summary lists, most frequent first.
+const SKIPPED_LISTED: usize = 12;
+
 /// How many part names an error lists before it says "...".
 const NAMES_IN_ERRORS: usize = 5;
 
@@ -161,9 +164,52 @@ pub struct Skipped {
     pub first: Location,
 }
 
+/// What one build had that could not be learned from.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct BuildSkips {
+    /// The build.
+    pub file: PathBuf,
+    /// Part references read.
+    pub pieces: usize,
+    /// Pieces learned from.
+    pub learned: usize,
+    /// Pieces of parts outside the catalog.
+    pub unknown: usize,
+    /// Pieces turned off the vertical axis (not by a quarter turn about it).
+    pub tilted: usize,
+    /// Pieces off the stud grid or the half-plate grid.
+    pub off_grid: usize,
+    /// Part definitions packed inside the file (an MPD's `0 !LDRAW_ORG Part`
+    /// sections), read as parts, not as submodels.
+    pub packed_parts: usize,
+    /// The line of the first tilted piece.
+    pub first_tilted: Option<usize>,
+    /// The line of the first piece off the grid.
+    pub first_off_grid: Option<usize>,
+}
+
+impl BuildSkips {
+    /// Pieces skipped.
+    pub fn skipped(&self) -> usize {
+        self.unknown + self.tilted + self.off_grid
+    }
+}
+
 /// What was read and what was left out.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct LearnReport {
+    /// What each build had that could not be learned from, in the order
+    /// read.
+    pub per_build: Vec<BuildSkips>,
+    /// Pieces skipped as tilted, in all.
+    pub tilted: usize,
+    /// Pieces skipped as off the grid, in all.
+    pub off_grid: usize,
+    /// Part definitions packed inside the files, in all.
+    pub packed_parts: usize,
+    /// Builds that had nothing to learn from, with why; [`learn`] skips
+    /// them and goes on.
+    pub empty_builds: Vec<(PathBuf, String)>,
     /// The builds read, as given, in the order read.
     pub builds: Vec<PathBuf>,
     /// Submodel instances built separately inside them.
@@ -203,11 +249,32 @@ pub struct Learned {
 /// A directory in `paths` stands for the `.ldr` and `.mpd` files in it. The
 /// files are read in sorted order, each once, so the same files in any
 /// order give the same result.
+///
+/// A build with nothing to learn from (no catalog piece on the grid) is
+/// skipped and listed in [`LearnReport::empty_builds`]; it is an error only
+/// when no build at all teaches anything.
 pub fn learn(paths: &[PathBuf]) -> Result<Learned, LearnError> {
     let mut learner = Learner::new();
+    let mut empty = Vec::new();
+    let mut last_empty = None;
     for path in build_files(paths)? {
-        learner.add(&read_ldr(&path)?)?;
+        match learner.add(&read_ldr(&path)?) {
+            Ok(()) => {}
+            Err(e @ LearnError::NothingToLearn { .. }) => {
+                if let LearnError::NothingToLearn { path, why } = &e {
+                    empty.push((path.clone(), why.clone()));
+                }
+                last_empty = Some(e);
+            }
+            Err(e) => return Err(e),
+        }
     }
+    if learner.builds.is_empty() {
+        if let Some(e) = last_empty {
+            return Err(e);
+        }
+    }
+    learner.report.empty_builds = empty;
     learner.finish()
 }
 
@@ -270,26 +337,51 @@ impl Learner {
         Learner::default()
     }
 
-    /// Reads one build.
+    /// Reads one build, learning from every piece it can: pieces of parts
+    /// outside the catalog, tilted pieces and pieces off the stud or
+    /// half-plate grid are skipped and counted ([`BuildSkips`]).
     ///
-    /// Errors, taking nothing in, if a catalog piece is off the grid or
-    /// tilted, or if the build has no catalog piece at all.
+    /// Errors, taking nothing in, if the build has no catalog piece it can
+    /// learn from.
     pub fn add(&mut self, model: &LdrModel) -> Result<(), LearnError> {
         let mut placed: Vec<(usize, Placement)> = Vec::new();
         let mut skipped: Vec<(String, usize)> = Vec::new();
+        let mut mine = BuildSkips {
+            file: model.path.clone(),
+            pieces: model.parts.len(),
+            packed_parts: model.packed_parts,
+            ..BuildSkips::default()
+        };
         for r in &model.parts {
-            if PartKind::from_id(&r.part).is_none() {
+            let Some(kind) = catalog_part(&r.part) else {
                 skipped.push((part_name(&r.part), r.line));
+                mine.unknown += 1;
                 continue;
+            };
+            let r = &crate::ldraw::PartRef {
+                part: kind.spec().id.0.to_string(),
+                ..r.clone()
+            };
+            match to_placement(r, &model.path) {
+                Ok(p) => placed.push((r.instance, p)),
+                Err(LdrError::NotQuarterTurn { line, .. }) => {
+                    mine.tilted += 1;
+                    mine.first_tilted.get_or_insert(line);
+                }
+                Err(LdrError::OffGrid { line, .. }) => {
+                    mine.off_grid += 1;
+                    mine.first_off_grid.get_or_insert(line);
+                }
+                Err(e) => return Err(e.into()),
             }
-            placed.push((r.instance, to_placement(r, &model.path)?));
         }
         let Some(low) = placed.iter().map(|(_, p)| p.origin.z).min() else {
             return Err(LearnError::NothingToLearn {
                 path: model.path.clone(),
-                why: nothing_to_learn(&skipped),
+                why: nothing_to_learn(&skipped, &mine),
             });
         };
+        mine.learned = placed.len();
         for (_, p) in &mut placed {
             p.origin.z -= low;
         }
@@ -307,6 +399,10 @@ impl Learner {
                 .count += 1;
         }
         let r = &mut self.report;
+        r.tilted += mine.tilted;
+        r.off_grid += mine.off_grid;
+        r.packed_parts += mine.packed_parts;
+        r.per_build.push(mine);
         r.builds.push(model.path.clone());
         r.submodel_builds += model.instances.len() - 1;
         r.pieces += model.parts.len();
@@ -424,6 +520,36 @@ fn count_build(
     }
 }
 
+/// The catalog part a reference names, as people's files write it: with
+/// a folder (`parts/3001.dat`, as packed files have it), or another
+/// variant of the same shape (`3023` for the catalog's `3023b`, `3040a` for
+/// `3040b`, a print such as `3039p23` for `3039`): the one catalog part whose
+/// number is the same, if there is exactly one.
+pub fn catalog_part(written: &str) -> Option<PartKind> {
+    let name = written.trim().replace('\\', "/");
+    let name = name.rsplit('/').next().unwrap_or(&name);
+    if let Some(k) = PartKind::from_id(name) {
+        return Some(k);
+    }
+    let stem = name.to_ascii_lowercase();
+    let stem = stem.strip_suffix(".dat").unwrap_or(&stem);
+    let digits = |s: &str| -> String { s.chars().take_while(char::is_ascii_digit).collect() };
+    let number = digits(stem);
+    // A letter and digits after the number are a variant or a print; a
+    // part with anything else after it (`3001s01`, a subpart) is not.
+    let rest = &stem[number.len()..];
+    let variant = rest.is_empty()
+        || rest.len() == 1 && rest.chars().all(|c| c.is_ascii_alphabetic())
+        || rest.starts_with('p') && rest[1..].chars().all(|c| c.is_ascii_alphanumeric());
+    if number.is_empty() || !variant {
+        return None;
+    }
+    let mut same = PartKind::all().filter(|k| digits(k.spec().id.0) == number);
+    match (same.next(), same.next()) {
+        (Some(k), None) => Some(k),
+        _ => None,
+    }
+}
 /// How many pieces a cell of [`count_build`]'s index remembers: one in a
 /// build without overlaps; the bound keeps a pile of copies linear.
 const MAX_PIECES_PER_CELL: usize = 8;
@@ -438,7 +564,13 @@ fn part_name(written: &str) -> String {
 }
 
 /// Why a build with no catalog piece teaches nothing.
-fn nothing_to_learn(skipped: &[(String, usize)]) -> String {
+fn nothing_to_learn(skipped: &[(String, usize)], mine: &BuildSkips) -> String {
+    if mine.tilted + mine.off_grid > 0 {
+        return format!(
+            "of its {} part references, {} are tilted, {} off the grid and {} outside brickwright's catalog",
+            mine.pieces, mine.tilted, mine.off_grid, mine.unknown
+        );
+    }
     if skipped.is_empty() {
         return "it has no part references (type-1 lines)".into();
     }
@@ -609,12 +741,17 @@ impl Learned {
         for line in wrap(&names, 74) {
             let _ = writeln!(h, "  {line}");
         }
+        let unknown = r.pieces - r.learned_pieces - r.tilted - r.off_grid;
         let _ = writeln!(
             h,
-            "{} read: {} of catalog parts, {} skipped (not in the catalog).",
+            "{} read: {} of catalog parts, {} skipped ({} not in the catalog,\n\
+             {} tilted, {} off the grid).",
             plural(r.pieces, "piece"),
             thousands(r.learned_pieces as u64),
-            thousands((r.pieces - r.learned_pieces) as u64)
+            thousands((r.pieces - r.learned_pieces) as u64),
+            thousands(unknown as u64),
+            thousands(r.tilted as u64),
+            thousands(r.off_grid as u64)
         );
         let _ = writeln!(h, "{}.", self.totals());
         let extra = self.rules.alphabet().len().saturating_sub(r.parts.len());
@@ -673,9 +810,45 @@ impl Learned {
             thousands(r.learned_pieces as u64),
             thousands((r.pieces - r.learned_pieces) as u64)
         );
+        let unknown = r.pieces - r.learned_pieces - r.tilted - r.off_grid;
+        let _ = writeln!(
+            s,
+            "  skipped: {} not in the catalog, {} tilted, {} off the grid; \
+             {} read as parts (definitions packed in the files)",
+            thousands(unknown as u64),
+            thousands(r.tilted as u64),
+            thousands(r.off_grid as u64),
+            plural(r.packed_parts, "part definition")
+        );
+        for b in r.per_build.iter().filter(|b| b.skipped() > 0) {
+            let mut why = Vec::new();
+            if b.unknown > 0 {
+                why.push(format!("{} not in the catalog", b.unknown));
+            }
+            if let Some(line) = b.first_tilted {
+                why.push(format!("{} tilted (first at line {line})", b.tilted));
+            }
+            if let Some(line) = b.first_off_grid {
+                why.push(format!(
+                    "{} off the grid (first at line {line})",
+                    b.off_grid
+                ));
+            }
+            let _ = writeln!(
+                s,
+                "    {}: learned {} of {}; skipped {}",
+                b.file.display(),
+                thousands(b.learned as u64),
+                thousands(b.pieces as u64),
+                why.join(", ")
+            );
+        }
+        for (file, why) in &r.empty_builds {
+            let _ = writeln!(s, "    {}: skipped whole: {why}", file.display());
+        }
         if !r.skipped.is_empty() {
             s.push_str("  skipped, not in the catalog:\n");
-            for k in &r.skipped {
+            for k in r.skipped.iter().take(SKIPPED_LISTED) {
                 let _ = writeln!(
                     s,
                     "  {:>6} x {:<10} first at {}:{}",
@@ -683,6 +856,13 @@ impl Learned {
                     k.part,
                     k.first.file.display(),
                     k.first.line
+                );
+            }
+            if r.skipped.len() > SKIPPED_LISTED {
+                let _ = writeln!(
+                    s,
+                    "  ... and {} more parts",
+                    r.skipped.len() - SKIPPED_LISTED
                 );
             }
         }

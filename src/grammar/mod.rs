@@ -10,9 +10,11 @@
 //! - a **complex rule** `u -> v` adds several pieces, in order, where
 //!   several pieces are in place (module [`complex`]; paper, Figure 4).
 //!
-//! Each rule carries a weight: how often people use it. The search samples
-//! rules from the categorical distribution of these weights, so common,
-//! sturdy joints are tried first.
+//! Each rule carries a weight: how often people use it. The layout (the
+//! default search) adds, among pieces of equal fit, the one whose joint the
+//! heaviest rule makes; the backward search (`--search backward`) draws the
+//! rules it tries at each node from the categorical distribution of the
+//! weights, so common, sturdy joints are tried first.
 //!
 //! Rules are read from human-readable files ([`RuleSet::parse`]); the file
 //! gives each rule once, with `A` unturned, and the loader generates the
@@ -33,6 +35,7 @@ pub mod complex;
 mod cover;
 mod defaults;
 pub mod learn;
+mod numbering;
 mod parse;
 
 pub use complex::{ComplexId, ComplexRule, ComplexVariant, Link, NewPiece, Plates, RulePiece};
@@ -40,6 +43,7 @@ pub use defaults::{
     default_rules, default_rules_text, extended_alphabet, rules_text, COMPLEX_RULES,
     DEFAULT_ALPHABET,
 };
+pub use numbering::{Numbering, RuleNumbers};
 pub use parse::RuleError;
 
 use serde::Serialize;
@@ -147,6 +151,9 @@ pub struct RuleSet {
     complex_variants: Vec<ComplexVariant>,
     /// Where the rules came from, for reports.
     pub source: String,
+    /// The numbering of the file this set was cut down from
+    /// ([`RuleSet::restricted`]); `None`: the set numbers itself.
+    numbered: Option<Box<Numbering>>,
 }
 
 /// The height, in LDU, of one voxel layer for an alphabet: a brick (24)
@@ -185,6 +192,7 @@ impl RuleSet {
             complex: Vec::new(),
             complex_variants: Vec::new(),
             source,
+            numbered: None,
         };
         set.variants = set.generate_variants()?;
         Ok(set)
@@ -238,7 +246,9 @@ impl RuleSet {
             .filter(|r| r.u.iter().chain(&r.v).all(|p| keep(p.part)) && set.fits_layers(r))
             .cloned()
             .collect();
-        set.with_complex(complex)
+        let mut set = set.with_complex(complex)?;
+        set.numbered = Some(Box::new(self.numbering()));
+        Ok(set)
     }
 
     /// The letters of Σ.

@@ -71,6 +71,7 @@
 //!     author: "brickwright".into(),
 //!     notes: vec![],
 //!     step_notes: Default::default(),
+//!     piece_notes: Default::default(),
 //! };
 //! let mut out = Vec::new();
 //! write_ldr(&mut out, &asm, &meta).unwrap();

@@ -97,6 +97,10 @@ pub struct LdrModel {
     /// Every model instance, in the order they were expanded: the main
     /// model first, then each submodel reference depth first.
     pub instances: Vec<Instance>,
+    /// Part definitions packed inside the file (`0 FILE` sections marked
+    /// `0 !LDRAW_ORG Part`, `Subpart`, `Primitive`, ...): never expanded,
+    /// a reference to one is a part reference.
+    pub packed_parts: usize,
 }
 
 /// Reads and parses the LDraw (`.ldr` or `.mpd`) file at `path`.
@@ -143,6 +147,7 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
         path: path.to_path_buf(),
         parts,
         instances,
+        packed_parts: file.sections.iter().filter(|s| s.part).count(),
     })
 }
 
@@ -370,6 +375,10 @@ struct RawRef {
 #[derive(Debug, Default)]
 struct Section {
     cmds: Vec<Cmd>,
+    /// The section defines a part (`0 !LDRAW_ORG Part`, `Subpart`,
+    /// `Primitive`, ...), as packed files inline the official parts they
+    /// use: a reference to it is a part, not a submodel.
+    part: bool,
 }
 
 /// The sections of a file, with the main one and a lookup by name.
@@ -378,6 +387,28 @@ struct File {
     sections: Vec<Section>,
     by_name: HashMap<String, usize>,
     main: usize,
+}
+
+/// Whether a `0 !LDRAW_ORG` line's type (`Part UPDATE 2004-01`,
+/// `Unofficial_Subpart`, `48_Primitive`, `Shortcut`, ...) marks a part
+/// definition rather than a model.
+fn defines_part(kind: &str) -> bool {
+    let Some((word, _)) = next_token(kind) else {
+        return false;
+    };
+    let word = word.to_ascii_lowercase();
+    let word = word.strip_prefix("unofficial_").unwrap_or(&word);
+    [
+        "part",
+        "subpart",
+        "primitive",
+        "8_primitive",
+        "48_primitive",
+        "shortcut",
+        "alias",
+        "physical_colour",
+    ]
+    .contains(&word)
 }
 
 /// Submodel names compare case-insensitively, with either slash.
@@ -439,6 +470,12 @@ fn parse_sections(text: &str, path: &Path) -> Result<File, LdrError> {
                     current = None;
                     continue;
                 }
+                Some((word, kind)) if word.eq_ignore_ascii_case("!LDRAW_ORG") => {
+                    if let (Some(Some(idx)), true) = (current, defines_part(kind)) {
+                        sections[idx].part = true;
+                    }
+                    continue;
+                }
                 Some((word, _))
                     if word.eq_ignore_ascii_case("STEP")
                         || word.eq_ignore_ascii_case("ROTSTEP") =>
@@ -469,6 +506,8 @@ fn parse_sections(text: &str, path: &Path) -> Result<File, LdrError> {
     if sections.is_empty() {
         sections.push(preamble);
     }
+    // The main model is a model even if it says otherwise.
+    sections[0].part = false;
     Ok(File {
         sections,
         by_name,
@@ -614,7 +653,12 @@ impl<'a> Flattener<'a> {
             r.color
         };
         let file: &'a File = self.file;
-        let Some(&sub) = file.by_name.get(&normalize_name(&r.name)) else {
+        let sub = file
+            .by_name
+            .get(&normalize_name(&r.name))
+            .copied()
+            .filter(|&i| !file.sections[i].part);
+        let Some(sub) = sub else {
             self.out.push(PartRef {
                 step,
                 color,
@@ -655,6 +699,27 @@ mod tests {
 
     fn parse(text: &str) -> Result<LdrModel, LdrError> {
         parse_ldr(text, Path::new("t.ldr"))
+    }
+
+    #[test]
+    fn a_packed_part_definition_is_a_part_not_a_submodel() {
+        let text = "0 FILE main.ldr\n\
+            1 4 0 -24 0 1 0 0 0 1 0 0 0 1 3001.dat\n\
+            1 4 0 -48 0 1 0 0 0 1 0 0 0 1 sub.ldr\n\
+            0 FILE sub.ldr\n\
+            1 4 0 0 0 1 0 0 0 1 0 0 0 1 3003.dat\n\
+            0 FILE 3001.dat\n\
+            0 !LDRAW_ORG Part UPDATE 2004-03\n\
+            1 16 0 0 0 1 0 0 0 1 0 0 0 1 stud.dat\n\
+            0 FILE 3003.dat\n\
+            0 !LDRAW_ORG Unofficial_Part\n\
+            1 16 0 0 0 1 0 0 0 1 0 0 0 1 s/3003s01.dat\n";
+        let m = parse(text).unwrap();
+        let names: Vec<&str> = m.parts.iter().map(|p| p.part.as_str()).collect();
+        assert_eq!(names, ["3001.dat", "3003.dat"]);
+        assert_eq!(m.packed_parts, 2);
+        // The submodel is still a separate instance.
+        assert_eq!(m.instances.len(), 2);
     }
 
     #[test]

@@ -26,6 +26,10 @@ pub struct LdrMeta {
     /// A comment line (`0 // ...`) at the start of a step, by step number:
     /// what the step is for (a support column, say).
     pub step_notes: std::collections::BTreeMap<u32, String>,
+    /// A comment line (`0 // ...`) just before a piece, by the piece's
+    /// index in the assembly: the rule of the derivation that adds it
+    /// (`rule 5`). LDraw tools ignore `0 //` comments.
+    pub piece_notes: std::collections::BTreeMap<usize, String>,
 }
 
 /// Writes `asm` as an LDraw `.ldr` model to `w`.
@@ -44,6 +48,9 @@ pub fn write_ldr(w: &mut dyn Write, asm: &Assembly, meta: &LdrMeta) -> io::Resul
     for (i, piece) in asm.pieces.iter().enumerate() {
         let starts = i == 0 || asm.pieces[i - 1].step != piece.step;
         if let Some(note) = meta.step_notes.get(&piece.step.0).filter(|_| starts) {
+            header_line(w, "// ", note)?;
+        }
+        if let Some(note) = meta.piece_notes.get(&i) {
             header_line(w, "// ", note)?;
         }
         let p = &piece.placement;
@@ -130,6 +137,26 @@ mod tests {
     }
 
     #[test]
+    fn a_piece_note_comes_just_before_its_piece() {
+        let brick = PartKind::from_id("3005").unwrap();
+        let order = [
+            Placement::new(brick, Cell::new(0, 0, 0), Rot::R0),
+            Placement::new(brick, Cell::new(0, 0, 1), Rot::R0),
+        ];
+        let asm = Assembly::from_order(&order, 24, Color::RED);
+        let meta = LdrMeta {
+            piece_notes: [(0, "rule 0".to_string()), (1, "rule 7".to_string())].into(),
+            ..LdrMeta::default()
+        };
+        let text = write(&asm, &meta);
+        assert!(text.contains("0 // rule 0\n1 4 10 -24 10"), "{text}");
+        assert!(
+            text.contains("0 STEP\n0 // rule 7\n1 4 10 -48 10"),
+            "{text}"
+        );
+    }
+
+    #[test]
     fn header_texts_cannot_inject_lines() {
         let meta = LdrMeta {
             title: "evil\n1 4 0 0 0 1 0 0 0 1 0 0 0 1 3001.dat".into(),
@@ -137,6 +164,7 @@ mod tests {
             author: "me\r\n".into(),
             notes: vec!["a\nb".into()],
             step_notes: Default::default(),
+            piece_notes: Default::default(),
         };
         let text = write(&Assembly::from_order(&[], 24, Color::RED), &meta);
         assert_eq!(

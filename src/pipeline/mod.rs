@@ -139,11 +139,21 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     };
 
     let pages = booklet.as_ref().map(|b| b.pages);
-    let mut report = report::compose(opts, &mesh, &model, &settled, hollow, pages, times);
+    let mut report = report::compose(
+        opts,
+        &setup.rules,
+        &mesh,
+        &model,
+        &settled,
+        hollow,
+        pages,
+        times,
+    );
     report.warnings.extend(planner.notes());
     progress.stage("writing");
     let report = write::write(
         opts,
+        &setup.rules,
         &settled,
         &pictures,
         rendered.as_ref(),

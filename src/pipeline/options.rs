@@ -314,8 +314,12 @@ pub(super) fn describe(opts: &BuildOptions) -> String {
         Stability::Repair => String::new(),
         s => format!(" --stability {}", s.name()),
     };
+    let search = match opts.search.method {
+        crate::search::Method::Layout => "",
+        crate::search::Method::Backward => " --search backward",
+    };
     format!(
-        "{size} --up {up} --seed {}{rules}{slopes}{plates}{steps}{palette}{stability}",
+        "{size} --up {up} --seed {}{search}{rules}{slopes}{plates}{steps}{palette}{stability}",
         opts.search.seed
     )
 }

@@ -10,8 +10,9 @@ use super::{BuildOptions, Formats, Stability, StabilityReport};
 use crate::assembly::Assembly;
 use crate::catalog::{Color, Palette};
 use crate::export::partslist::{Condition, PartsList, PartsRow};
+use crate::grammar::RuleSet;
 use crate::mesh::Mesh;
-use crate::search::{Repairs, SearchStats};
+use crate::search::{Derivation, Repairs, SearchStats};
 use crate::voxel::{Sizing, Up, VoxelColors, VoxelGrid};
 
 /// Seconds spent in each stage.
@@ -118,6 +119,9 @@ pub struct BuildReport {
     pub seconds: StageTimes,
     /// Search counters.
     pub search: SearchStats,
+    /// The rule sequence of the build, in the loaded rule file's numbers
+    /// (forward, and backward as the paper prints it).
+    pub derivation: Derivation,
     /// What had to change so the voxels could be built.
     pub repairs: Repairs,
     /// Files written.
@@ -267,8 +271,10 @@ pub(super) fn mesh_color_report(
 /// (`hollow`: beside the solid build), its booklet `booklet_pages` long,
 /// the stages having taken `times` (the outputs and
 /// the write time are filled in when they are written).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn compose(
     opts: &BuildOptions,
+    rules: &RuleSet,
     mesh: &Mesh,
     voxels: &Voxels,
     settled: &Settled,
@@ -315,6 +321,7 @@ pub(super) fn compose(
         size_cm: size_cm(outcome.voxels.dims(), layer_ldu),
         seconds: times,
         search: outcome.stats.clone(),
+        derivation: Derivation::of(&outcome.order, rules),
         repairs: outcome.repairs.clone(),
         outputs: Vec::new(),
     }

@@ -8,6 +8,7 @@ use crate::export::gltf::{write_gltf, Container, GltfOptions};
 use crate::export::html::{write_html, HtmlOptions};
 use crate::export::partslist::{write_bricklink, write_rebrickable_csv, PartsList};
 use crate::fsutil::{refuse_link, CreatedDirs, Outputs};
+use crate::grammar::RuleSet;
 use crate::ldraw::{write_ldr, LdrMeta};
 
 /// The booklet: its PDF and page count.
@@ -28,8 +29,22 @@ pub(super) fn booklet(
 }
 
 /// The `.ldr` file's header: what made it, from what, how.
-fn ldr_meta(opts: &BuildOptions, pictures: &Pictures<'_>) -> LdrMeta {
+fn ldr_meta(
+    opts: &BuildOptions,
+    pictures: &Pictures<'_>,
+    settled: &Settled,
+    rules: &RuleSet,
+) -> LdrMeta {
     let stem = pictures.title;
+    // Each piece's rule; support columns added after the search have none.
+    let by_piece = crate::search::piece_rules(&settled.outcome.order, rules);
+    let piece_notes = settled
+        .assembly
+        .pieces
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| Some((i, format!("rule {}", by_piece.get(&p.placement)?))))
+        .collect();
     LdrMeta {
         title: format!("{stem}, built by brickwright"),
         name: format!("{stem}.ldr"),
@@ -47,6 +62,7 @@ fn ldr_meta(opts: &BuildOptions, pictures: &Pictures<'_>) -> LdrMeta {
             format!("seed: {}", opts.search.seed),
         ],
         step_notes: pictures.step_notes.clone(),
+        piece_notes,
     }
 }
 
@@ -58,6 +74,7 @@ fn ldr_meta(opts: &BuildOptions, pictures: &Pictures<'_>) -> LdrMeta {
 /// write time.
 pub(super) fn write(
     opts: &BuildOptions,
+    rules: &RuleSet,
     settled: &Settled,
     pictures: &Pictures<'_>,
     rendered: Option<&Rendered>,
@@ -74,7 +91,7 @@ pub(super) fn write(
     let mut made = CreatedDirs::new();
     made.create(&opts.out_dir).map_err(failed(&opts.out_dir))?;
     let report_path = opts.out_dir.join("report.json");
-    let meta = ldr_meta(opts, pictures);
+    let meta = ldr_meta(opts, pictures, settled, rules);
     let parts = PartsList::of(assembly);
     let mut files = Outputs::new(&opts.out_dir).map_err(failed(&opts.out_dir))?;
     for format in opts.formats.iter() {

@@ -29,6 +29,7 @@
 //! piece scored against a fixed set of candidates over it, and bodies are
 //! tracked with a union-find.
 
+mod backward;
 mod cap;
 mod complex;
 mod derive;
@@ -38,6 +39,7 @@ mod merge;
 mod prepare;
 mod rulebook;
 mod sequence;
+mod written;
 
 use std::time::{Duration, Instant};
 
@@ -49,7 +51,9 @@ use thiserror::Error;
 use crate::assembly::Placement;
 use crate::grammar::{RuleRef, RuleSet};
 use crate::voxel::{Slant, VoxelGrid, Wall};
+pub use backward::{parts as hierarchy_parts, CUT_RATIO};
 pub use prepare::{components, LeftOut, Repairs};
+pub use written::{piece_rules, total_variation, Derivation};
 
 /// The most voxels a model may have: some 400,000 bricks.
 pub const MAX_VOXELS: usize = 2_000_000;
@@ -70,9 +74,32 @@ pub struct SearchOptions {
     /// Build a shell with walls this thick and the inside empty (see
     /// [`crate::voxel::hollow()`]); `None`, the default, builds solid.
     pub hollow: Option<Wall>,
+    /// Which search: the layout (the default) or the paper's backward
+    /// tracing.
+    pub method: Method,
+    /// Backward tracing: the branching factor `b`, from its first value
+    /// at the root to its second as the voxels run out (paper: 10-30
+    /// rising to 100-200). Default (20, 150).
+    pub branching: (u32, u32),
+    /// Backward tracing: the most tree nodes before it gives up. Default
+    /// 1,000,000.
+    pub node_budget: u64,
+    /// Backward tracing: cut the voxels into parts at horizontal planes
+    /// (the paper's hierarchical approach). Default true.
+    pub cut: bool,
     /// Cap stair edges with slopes after the layout, where the rules have
     /// slopes. Default `true`.
     pub cap_stairs: bool,
+}
+
+/// Which search builds the voxels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum Method {
+    /// The forward layout, course by course ([`build`]'s stages).
+    #[default]
+    Layout,
+    /// The paper's backward tracing (module `backward`).
+    Backward,
 }
 
 impl Default for SearchOptions {
@@ -82,6 +109,10 @@ impl Default for SearchOptions {
             time_budget: Duration::from_secs(300),
             complex_every: 0,
             hollow: None,
+            method: Method::Layout,
+            branching: (20, 150),
+            node_budget: 1_000_000,
+            cut: true,
             cap_stairs: true,
         }
     }
@@ -103,6 +134,24 @@ impl SearchOptions {
     /// Builds hollow with walls `wall` thick (`None`: solid).
     pub fn with_hollow(mut self, wall: Option<Wall>) -> Self {
         self.hollow = wall;
+        self
+    }
+
+    /// Sets the search method.
+    pub fn with_method(mut self, m: Method) -> Self {
+        self.method = m;
+        self
+    }
+
+    /// Sets the backward tracing's node budget.
+    pub fn with_node_budget(mut self, n: u64) -> Self {
+        self.node_budget = n;
+        self
+    }
+
+    /// Sets the backward tracing's branching factor, first and last.
+    pub fn with_branching(mut self, first: u32, last: u32) -> Self {
+        self.branching = (first, last);
         self
     }
 
@@ -148,6 +197,11 @@ pub struct SearchStats {
     pub caps: u64,
     /// Whether the time budget ran out before every layer was laid.
     pub budget_hit: bool,
+    /// Backward tracing: times it went back up the tree from a node with
+    /// no rule left to try.
+    pub backtracks: u64,
+    /// Backward tracing: parts the voxels were cut into.
+    pub parts: u64,
 }
 
 /// A search that could not produce a build.
@@ -177,6 +231,18 @@ pub enum SearchError {
     /// The rules cannot build the shape.
     #[error("the rules cannot build this shape: {0}")]
     Rules(String),
+    /// The backward tracing found no derivation.
+    #[error("the backward search found no derivation: {why} ({nodes} nodes, {backtracks} backtracks, {secs:.1} s)")]
+    Backward {
+        /// Why it stopped.
+        why: String,
+        /// Tree nodes made.
+        nodes: u64,
+        /// Times it went back up the tree.
+        backtracks: u64,
+        /// Seconds spent.
+        secs: f64,
+    },
 }
 
 /// What a piece is attached to in the derivation.
@@ -297,6 +363,11 @@ pub fn build_guided(
     let started = Instant::now();
     let deadline = started + opts.time_budget;
     let (mut fixed, mut repairs) = prepare::repair_islands(voxels);
+    // The backward search traces the voxels as they are (islands joined
+    // only): thickening sheets would add voxels no rule may need.
+    if opts.method == Method::Backward {
+        return backward::build(fixed, repairs, None, rules, opts, started);
+    }
     // A course is a brick's height in layers; a sheet one course thick is
     // pieces side by side that cannot hold together, except plates, which
     // two layers laminate.

@@ -541,20 +541,61 @@ fn the_same_files_in_any_order_give_the_same_rule_file() {
 }
 
 #[test]
+fn tilted_and_off_grid_pieces_are_skipped_and_counted() {
+    let brick = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n";
+    let text = format!(
+        "{brick}1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n\
+         1 4 40 -26 20 1 0 0 0 1 0 0 0 1 3001.dat\n\
+         0 c\n1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n\
+         1 4 40 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n\
+         1 4 40 -48 20 1 0 0 0 1 0 0 0 1 87079.dat\n"
+    );
+    let l = learn_one(&text);
+    let r = &l.report;
+    assert_eq!(
+        (r.tilted, r.off_grid, r.learned_pieces, r.pieces),
+        (1, 2, 2, 6)
+    );
+    let b = &r.per_build[0];
+    assert_eq!((b.unknown, b.tilted, b.off_grid, b.learned), (1, 1, 2, 2));
+    assert_eq!((b.first_off_grid, b.first_tilted), (Some(2), Some(5)));
+    // The two bricks on the grid still teach their joint.
+    assert_eq!(l.total(), 1);
+    let s = l.summary();
+    assert!(
+        s.contains("skipped: 1 not in the catalog, 1 tilted, 2 off the grid"),
+        "{s}"
+    );
+    assert!(s.contains("t.ldr: learned 2 of 6; skipped 1 not in the catalog, 1 tilted (first at line 5), 2 off the grid (first at line 2)"), "{s}");
+}
+
+#[test]
+fn a_build_with_nothing_to_learn_is_skipped_among_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("a.ldr");
+    let empty = dir.path().join("b.ldr");
+    std::fs::write(
+        &good,
+        "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n1 4 40 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n",
+    )
+    .unwrap();
+    std::fs::write(&empty, "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n").unwrap();
+    let l = learn(&[dir.path().to_path_buf()]).unwrap();
+    assert_eq!(l.report.builds, [good]);
+    assert_eq!(l.report.empty_builds.len(), 1);
+    assert_eq!(l.report.empty_builds[0].0, empty);
+    assert!(l
+        .summary()
+        .contains("b.ldr: skipped whole: its 1 part references are all outside"));
+}
+
+#[test]
 fn bad_builds_are_errors_naming_file_and_line() {
     let brick = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n";
     let cases = [
         (
-            format!("{brick}1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
-            "t.ldr:2: part `3001.dat` is off the grid: X = 45 LDU but 3001 turned r0 must sit at X = 20*n + 40",
-        ),
-        (
-            format!("{brick}1 4 40 -26 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
-            "t.ldr:2: part `3001.dat` is off the grid: Y = -26 LDU but 3001 must sit at Y = -(4*n + 24) to stand on the plate grid",
-        ),
-        (
-            format!("{brick}0 c\n1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n"),
-            "t.ldr:3: part `3001.dat` is not turned by a quarter turn about the vertical (-Y) axis",
+            "1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n".to_string(),
+            "t.ldr: nothing to learn from: of its 1 part references, 0 are tilted, 1 off the grid and 0 outside brickwright's catalog",
         ),
         (
             format!("{brick}this is not LDraw\n"),
@@ -811,4 +852,20 @@ fn summary_sets_the_totals_beside_the_papers() {
         "{lines:#?}"
     );
     assert_eq!(lines.join(" "), names.join(", "));
+}
+
+#[test]
+fn people_s_part_names_map_to_the_catalog() {
+    let id = |s: &str| catalog_part(s).map(|k| k.spec().id.0);
+    assert_eq!(id("3001.dat"), Some("3001"));
+    assert_eq!(id("parts/3001.dat"), Some("3001"));
+    assert_eq!(id("parts\\3003.DAT"), Some("3003"));
+    // Another variant or a print of the same shape.
+    assert_eq!(id("3023.dat"), Some("3023b"));
+    assert_eq!(id("3040a.dat"), Some("3040b"));
+    assert_eq!(id("3039p23.dat"), Some("3039"));
+    // A subpart, a primitive and an unknown part are not catalog parts.
+    assert_eq!(id("s/3001s01.dat"), None);
+    assert_eq!(id("stud.dat"), None);
+    assert_eq!(id("3069b.dat"), None);
 }

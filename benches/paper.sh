@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The paper's experiments at its scale (Lau et al., section 5, Figure 6):
+# each model built with `--search backward` and with the layout over seeds
+# 1-5, one line a run: model, search, seed, bricks (pieces), tree nodes,
+# backtracks, search seconds, success. Sizes (--studs) are chosen so the
+# layout's piece count is near the paper's brick count: house 61 bricks
+# (43 bricks and 24 slopes with slopes), skyscraper 92, mug 132.
+# Usage: benches/paper.sh. SEEDS (default "1 2 3 4 5"), BUDGET (backward
+# time budget in seconds, default 60), NODES (backward node budget, default
+# 1000000) and BIN (a brickwright binary; default: this tree's, built)
+# override. The stand-ins: fixtures/house.obj for the house,
+# fixtures/tower.glb (a box under a taller narrower box) for the skyscraper,
+# fixtures/mug.obj for the mug. There is no shuttle fixture yet.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+seeds=${SEEDS:-"1 2 3 4 5"}
+budget=${BUDGET:-60}
+nodes=${NODES:-1000000}
+bin=${BIN:-target/release/brickwright}
+if [ -z "${BIN:-}" ]; then
+    cargo build --release --quiet
+fi
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+# model|mesh|studs|extra options
+models=(
+    "house|fixtures/house.obj|12|"
+    "house, slopes|fixtures/house.obj|11|--slopes"
+    "skyscraper|fixtures/tower.glb|14|"
+    "mug|fixtures/mug.obj|15|"
+)
+printf '| model | search | seed | bricks | nodes | backtracks | search s | success |\n'
+printf '|---|---|---|---|---|---|---|---|\n'
+for m in "${models[@]}"; do
+    IFS='|' read -r name mesh studs extra <<< "$m"
+    for search in backward layout; do
+        for seed in $seeds; do
+            rm -rf "$out/run"
+            # shellcheck disable=SC2086
+            "$bin" build "$mesh" -o "$out/run" --studs "$studs" --seed "$seed" $extra \
+                --search "$search" --node-budget "$nodes" --time-budget "$budget" \
+                --formats ldr --quiet 2>"$out/err" >/dev/null
+            rc=$?
+            if [ "$rc" -eq 0 ]; then
+                python3 - "$out/run/report.json" "$name" "$search" "$seed" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+s = r["search"]
+print(f"| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {r['pieces']} | {s['nodes']} "
+      f"| {s['backtracks']} | {r['seconds']['search']:.2f} | yes |")
+PY
+            else
+                # "... (N nodes, B backtracks, S s)" from the one-line failure.
+                err=$(tr '\n' ' ' < "$out/err")
+                n=$(sed -n 's/.*(\([0-9]*\) nodes, \([0-9]*\) backtracks, \([0-9.]*\) s).*/\1 | \2 | \3/p' <<< "$err")
+                [ -n "$n" ] || n="- | - | -"
+                printf '| %s | %s | %s | - | %s | no (exit %s) |\n' "$name" "$search" "$seed" "$n" "$rc"
+            fi
+        done
+    done
+done

@@ -1,0 +1,145 @@
+//! Whether a new piece can be put in place: the paper's flood fill.
+//!
+//! Before a rule is applied in reverse, the new piece must be able to reach
+//! its place past what is already built (paper, section 4: "we check that
+//! there is space below or above the new piece(s) and that the space is
+//! not completely enclosed ... by flood filling the empty space of the
+//! voxel grid with the padded piece until it reaches some boundary or it
+//! is completely enclosed"). The piece's box is moved a cell at a time
+//! through empty cells, from its place, until it is clear of the grid
+//! (placeable) or no move is left (enclosed). Moving whole cells is the
+//! padding: a box never slips through a gap narrower than itself, nor past
+//! a corner it would graze. The straight paths, up and down, are tried
+//! first: they are nearly always the answer.
+
+use std::collections::{HashSet, VecDeque};
+
+use crate::geom::{Cell, CellBox};
+use crate::voxel::VoxelGrid;
+
+/// The most positions one flood fill visits before it calls the piece
+/// enclosed (a box in a hollow far bigger than any model of this size).
+const MAX_VISITED: usize = 200_000;
+
+/// The box of `sx` by `sy` by `sz` cells from `min`.
+fn bx(min: Cell, sx: i32, sy: i32, sz: i32) -> CellBox {
+    CellBox { min, sx, sy, sz }
+}
+
+/// Whether the box `b` can be pressed into its place from above
+/// (`from_above`, a piece pressed onto studs below it) or from below,
+/// through cells `solid` leaves empty: the cell layer beside it that way
+/// is empty, and from there the box travels out of the grid.
+pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> bool {
+    let clear = |at: &CellBox| !solid.any_set(at);
+    let (nx, ny, nz) = solid.dims();
+    // Straight up or straight down.
+    let column = |from: i32, to: i32| {
+        bx(
+            Cell::new(b.min.x, b.min.y, from.max(0)),
+            b.sx,
+            b.sy,
+            (to.min(nz) - from.max(0)).max(0),
+        )
+    };
+    let straight = if from_above {
+        column(b.min.z + b.sz, nz)
+    } else {
+        column(0, b.min.z)
+    };
+    if clear(&straight) {
+        return true;
+    }
+    // The box one cell that way must be free: it is pressed on last.
+    let dz = if from_above { 1 } else { -1 };
+    let first = bx(b.min.offset(0, 0, dz), b.sx, b.sy, b.sz);
+    if !clear(&first) {
+        return false;
+    }
+    let out = |m: Cell| {
+        m.x + b.sx <= 0 || m.y + b.sy <= 0 || m.z + b.sz <= 0 || m.x >= nx || m.y >= ny || m.z >= nz
+    };
+    let mut seen: HashSet<Cell> = HashSet::new();
+    let mut queue: VecDeque<Cell> = VecDeque::new();
+    seen.insert(b.min);
+    seen.insert(first.min);
+    queue.push_back(first.min);
+    while let Some(m) = queue.pop_front() {
+        if seen.len() > MAX_VISITED {
+            return false;
+        }
+        for (dx, dy, dz) in [
+            (1, 0, 0),
+            (-1, 0, 0),
+            (0, 1, 0),
+            (0, -1, 0),
+            (0, 0, 1),
+            (0, 0, -1),
+        ] {
+            let n = Cell::new(m.x + dx, m.y + dy, m.z + dz);
+            if seen.contains(&n) {
+                continue;
+            }
+            if out(n) {
+                return true;
+            }
+            if clear(&bx(n, b.sx, b.sy, b.sz)) {
+                seen.insert(n);
+                queue.push_back(n);
+            }
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(cells: &[(i32, i32, i32)]) -> VoxelGrid {
+        let mut g = VoxelGrid::new(5, 5, 5);
+        for &(x, y, z) in cells {
+            g.set(Cell::new(x, y, z), true);
+        }
+        g
+    }
+
+    #[test]
+    fn a_piece_under_a_roof_slides_out_sideways_but_not_from_a_closed_box() {
+        let b = bx(Cell::new(2, 2, 2), 1, 1, 1);
+        // A roof above and a floor below: it slides out to the side.
+        let g = grid(&[(2, 2, 3), (2, 2, 1)]);
+        assert!(!placeable(&b, &g, true));
+        let g = grid(&[(2, 2, 4), (2, 2, 1)]);
+        assert!(placeable(&b, &g, true));
+        assert!(!placeable(&b, &g, false));
+        let g = grid(&[(2, 2, 3), (2, 2, 0)]);
+        assert!(placeable(&b, &g, false));
+        // Walled in on all six sides: enclosed.
+        let g = grid(&[
+            (2, 2, 3),
+            (2, 2, 1),
+            (1, 2, 2),
+            (3, 2, 2),
+            (2, 1, 2),
+            (2, 3, 2),
+        ]);
+        assert!(!placeable(&b, &g, true));
+        // A 2-wide piece does not pass a 1-wide gap.
+        let wide = bx(Cell::new(1, 2, 2), 2, 1, 1);
+        let mut g = VoxelGrid::new(5, 5, 5);
+        for x in 0..5 {
+            for y in 0..5 {
+                if !(y == 2 && (1..=2).contains(&x)) {
+                    g.set(Cell::new(x, y, 2), true);
+                }
+                g.set(Cell::new(x, y, 1), true);
+                if x != 2 || y != 2 {
+                    g.set(Cell::new(x, y, 3), true);
+                }
+            }
+        }
+        assert!(!placeable(&wide, &g, true));
+        assert!(placeable(&bx(Cell::new(2, 2, 2), 1, 1, 1), &g, true));
+    }
+}
