@@ -822,52 +822,82 @@ fn learned_rules_drive_a_build() {
 #[test]
 fn learn_rejects_bad_builds_with_one_line() {
     let good = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n";
-    let cases = [
-        (
-            "garbage.ldr",
-            format!("{good}garbage here\n"),
-            "garbage.ldr:2: not LDraw text",
-        ),
-        (
-            "offgrid.ldr",
-            format!("{good}0 STEP\n1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
-            "offgrid.ldr:3: part `3001.dat` is off the grid",
-        ),
-        (
-            "tilted.ldr",
-            format!("{good}1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n"),
-            "tilted.ldr:2: part `3001.dat` is not turned by a quarter turn",
-        ),
+    let tmp = tempdir();
+    let ok = tmp.path().join("ok.ldr");
+    std::fs::write(&ok, good).unwrap();
+    // Text that is not LDraw fails the run, alone or after a good build.
+    let garbage = tmp.path().join("garbage.ldr");
+    std::fs::write(&garbage, format!("{good}garbage here\n")).unwrap();
+    let out = tmp.path().join("learned.rules");
+    for args in [
+        vec!["learn", s(&garbage), "-o", s(&out)],
+        vec!["learn", s(&ok), s(&garbage), "-o", s(&out)],
+    ] {
+        let run = run_in(tmp.path(), &args);
+        run.assert_clean_error();
+        assert!(
+            run.stderr.contains("garbage.ldr:2: not LDraw text"),
+            "{}",
+            run.describe()
+        );
+        assert!(!out.exists(), "a failed learn must write nothing");
+    }
+    // A build with nothing to learn from fails alone, and is skipped
+    // after a good one.
+    for (name, text, want) in [
         (
             "empty.ldr",
-            "0 nothing here\n0 STEP\n".to_string(),
+            "0 nothing here\n0 STEP\n",
             "empty.ldr: nothing to learn from",
         ),
         (
             "tiles.ldr",
-            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n".to_string(),
-            "empty.ldr: nothing to learn from",
+            "1 4 0 -8 0 1 0 0 0 1 0 0 0 1 87079.dat\n",
+            "tiles.ldr: nothing to learn from",
         ),
-    ];
-    for (name, text, want) in cases {
-        let tmp = tempdir();
+    ] {
         let path = tmp.path().join(name);
         std::fs::write(&path, text).unwrap();
-        let ok = tmp.path().join("ok.ldr");
-        std::fs::write(&ok, good).unwrap();
-        let want = want.replace("empty.ldr", name);
-        let out = tmp.path().join("learned.rules");
-        // Alone, and after a good build: the bad one still fails the run.
-        for args in [
-            vec!["learn", s(&path), "-o", s(&out)],
-            vec!["learn", s(&ok), s(&path), "-o", s(&out)],
-        ] {
-            let run = run_in(tmp.path(), &args);
-            run.assert_clean_error();
-            assert!(run.stderr.contains(&want), "{want}\n{}", run.describe());
-            assert!(!out.exists(), "a failed learn must write nothing");
-        }
+        let run = run_in(tmp.path(), &["learn", s(&path), "-o", s(&out)]);
+        run.assert_clean_error();
+        assert!(run.stderr.contains(want), "{want}\n{}", run.describe());
+        assert!(!out.exists(), "a failed learn must write nothing");
+        let run = run_in(tmp.path(), &["learn", s(&ok), s(&path), "-o", s(&out)]);
+        assert_eq!(run.code, Some(0), "{}", run.describe());
+        assert!(out.exists());
+        std::fs::remove_file(&out).unwrap();
     }
+}
+
+#[test]
+fn learn_skips_tilted_and_off_grid_pieces_and_counts_them() {
+    let good = "1 4 40 -24 20 1 0 0 0 1 0 0 0 1 3001.dat\n";
+    let tmp = tempdir();
+    for (name, text, want) in [
+        (
+            "offgrid.ldr",
+            format!("{good}0 STEP\n1 4 45 -48 20 1 0 0 0 1 0 0 0 1 3001.dat\n"),
+            "skipped 1 off the grid (first at line 3)",
+        ),
+        (
+            "tilted.ldr",
+            format!("{good}1 4 40 -48 20 1 0 0 0 0 -1 0 1 0 3001.dat\n"),
+            "1 tilted",
+        ),
+    ] {
+        let path = tmp.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = tmp.path().join("learned.rules");
+        let run = run_in(tmp.path(), &["learn", s(&path), "-o", s(&out)]);
+        assert_eq!(run.code, Some(0), "{}", run.describe());
+        assert!(run.stdout.contains("learned 1 of 2"), "{}", run.describe());
+        assert!(run.stdout.contains(want), "{want}\n{}", run.describe());
+        assert!(out.exists());
+    }
+}
+
+#[test]
+fn learn_rejects_missing_files_and_empty_folders() {
     let tmp = tempdir();
     let run = run_in(tmp.path(), &["learn", "missing.ldr"]);
     run.assert_clean_error();

@@ -103,8 +103,8 @@ impl RuleSet {
         }
     }
 
-    /// Each rule's number in the loaded file (see the module
-    /// [`numbering`](self)).
+    /// Each rule's number in the loaded file: the `rule` statements counted
+    /// in the order the file lists them (see [`RuleNumbers`]).
     pub fn numbers(&self) -> RuleNumbers {
         let n = self.numbering();
         let starts = self
