@@ -479,11 +479,17 @@ const PLACE_ROUNDS: usize = 6;
 fn derive(layout: &layout::Layout) -> (Vec<Removal>, Vec<u32>) {
     let (order, unreached) = derive::derive(layout);
     // The derivation's own order stands where the verifier finds every
-    // piece placeable; else the model is taken apart to find one.
-    if unplaceable(&order, layout.layer_ldu).is_empty() {
+    // piece placeable; else the model is taken apart to find one, kept
+    // when it shuts in fewer pieces and breaks nothing else.
+    let (blocked, others) = unplaceable_and_others(&order, layout.layer_ldu);
+    if blocked.is_empty() {
         return (order, unreached);
     }
-    let (order, _forced) = sequence::sequence(layout, order);
+    let (found, _) = sequence::sequence(layout, order.clone());
+    let (left, broken) = unplaceable_and_others(&found, layout.layer_ldu);
+    if broken <= others && left.len() < blocked.len() {
+        return (found, unreached);
+    }
     (order, unreached)
 }
 
