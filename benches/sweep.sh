@@ -6,8 +6,9 @@
 # OPTIONS (default: a `;`-separated list: the default options, --hollow,
 # --slopes, --plates, --palette layers) and STABILITY (default "off"; set it
 # to "repair" to run the stability stage too, with BUDGET seconds, default
-# 20) and BIN (a brickwright binary; default: this tree's, built) override. Prints one line a failing run and a summary; exits 1 if any
-# run failed.
+# 20) and BIN (a brickwright binary; default: this tree's, built) override.
+# Prints one line a failing run, one line a run that left voxels of the
+# model out (with how many), and a summary; exits 1 if any run failed.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 sizes=${SIZES:-"24 32 48 64 96"}
@@ -26,6 +27,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 runs=0
 failed=0
+lossy=0
 IFS=';' read -r -a option_sets <<< "$options"
 for mesh in "$@"; do
     [ -f "$mesh" ] || continue
@@ -42,10 +44,17 @@ for mesh in "$@"; do
                     failed=$((failed + 1))
                     printf 'exit %s: %s --studs %s --seed %s %s: %s\n' "$rc" "$mesh" "$n" "$seed" \
                         "$opt" "$(head -c 300 "$out/err" | tr '\n' ' ')"
+                    continue
+                fi
+                left=$(grep -o '"left_out": *[0-9]*' "$out/run/report.json" | head -n 1 | grep -o '[0-9]*$')
+                if [ "${left:-0}" -gt 0 ]; then
+                    lossy=$((lossy + 1))
+                    printf 'left out %s voxels: %s --studs %s --seed %s %s\n' "$left" "$mesh" "$n" \
+                        "$seed" "$opt"
                 fi
             done
         done
     done
 done
-printf '%s runs, %s failed\n' "$runs" "$failed"
+printf '%s runs, %s failed, %s left voxels out\n' "$runs" "$failed" "$lossy"
 [ "$failed" -eq 0 ]

@@ -30,6 +30,7 @@ mod physics;
 mod render;
 mod roofs;
 mod stability;
+mod sweep;
 mod test_rules;
 mod viewer;
 

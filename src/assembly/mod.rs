@@ -290,66 +290,86 @@ fn merge_small(mut sizes: Vec<usize>, cap: usize, courses: &[i32], reach: i32) -
         hi - lo <= reach
     };
     let fits = |a: (i32, i32), b: (i32, i32), n: usize| n <= cap && near(a, b);
+    let span_of = |start: usize, n: usize| course_span(&courses[start..start + n]);
+    // Each pass goes along the groups once: those behind it in `done`,
+    // those ahead in `ahead` (the current one last), so that joining two
+    // never moves the rest.
     loop {
         let mut changed = false;
-        let mut i = 0;
-        while i < sizes.len() {
-            if sizes[i] >= STEP_MIN_PIECES {
-                i += 1;
+        let mut done: Vec<(usize, (i32, i32))> = Vec::with_capacity(sizes.len());
+        let mut ahead: Vec<(usize, (i32, i32))> = sizes
+            .iter()
+            .copied()
+            .zip(span.iter().copied())
+            .rev()
+            .collect();
+        // Pieces in the groups behind.
+        let mut start = 0;
+        while let Some(&(n, sp)) = ahead.last() {
+            if n >= STEP_MIN_PIECES {
+                done.push((n, sp));
+                ahead.pop();
+                start += n;
                 continue;
             }
-            let before = (i > 0)
-                .then(|| sizes[i - 1] + sizes[i])
-                .filter(|&n| fits(span[i - 1], span[i], n));
-            let after = (i + 1 < sizes.len())
-                .then(|| sizes[i + 1] + sizes[i])
-                .filter(|&n| fits(span[i + 1], span[i], n));
+            let next = ahead.len().checked_sub(2).map(|k| ahead[k]);
+            let before = done
+                .last()
+                .map(|&(m, s)| (m + n, s))
+                .filter(|&(m, s)| fits(s, sp, m));
+            let after = next
+                .map(|(m, s)| (m + n, s))
+                .filter(|&(m, s)| fits(s, sp, m));
             match (before, after) {
-                (Some(b), a) if a.is_none_or(|a| b <= a) => {
-                    sizes[i - 1] = b;
-                    span[i - 1] = joined(span[i - 1], span[i]);
-                    sizes.remove(i);
-                    span.remove(i);
+                (Some((b, s)), a) if a.is_none_or(|a| b <= a.0) => {
+                    *done.last_mut().expect("a group behind") = (b, joined(s, sp));
+                    ahead.pop();
+                    start += n;
                     changed = true;
                 }
-                (_, Some(a)) => {
-                    sizes[i] = a;
-                    span[i] = joined(span[i], span[i + 1]);
-                    sizes.remove(i + 1);
-                    span.remove(i + 1);
+                (_, Some((a, s))) => {
+                    ahead.pop();
+                    *ahead.last_mut().expect("a group ahead") = (a, joined(sp, s));
                     changed = true;
                 }
                 _ => {
                     // Too many for one step: the group takes pieces from
                     // the smaller neighbour it may share a step with,
                     // the two halves of their pieces.
-                    let before = (i > 0)
-                        .then(|| sizes[i - 1])
-                        .filter(|&n| n + sizes[i] >= 2 * STEP_MIN_PIECES)
-                        .filter(|_| near(span[i - 1], span[i]));
-                    let after = (i + 1 < sizes.len())
-                        .then(|| sizes[i + 1])
-                        .filter(|&n| n + sizes[i] >= 2 * STEP_MIN_PIECES)
-                        .filter(|_| near(span[i + 1], span[i]));
-                    let (a, b) = match (before, after) {
-                        (Some(b), a) if a.is_none_or(|a| b <= a) => (i - 1, i),
-                        (_, Some(_)) => (i, i + 1),
+                    let before = done
+                        .last()
+                        .map(|&(m, s)| (m, s))
+                        .filter(|&(m, s)| m + n >= 2 * STEP_MIN_PIECES && near(s, sp));
+                    let after = next.filter(|&(m, s)| m + n >= 2 * STEP_MIN_PIECES && near(s, sp));
+                    match (before, after) {
+                        (Some((m, _)), a) if a.is_none_or(|a| m <= a.0) => {
+                            // The earlier group keeps the larger half.
+                            let total = m + n;
+                            let first = start - m;
+                            let (na, nb) = (total - total / 2, total / 2);
+                            *done.last_mut().expect("a group behind") = (na, span_of(first, na));
+                            *ahead.last_mut().expect("the group") = (nb, span_of(first + na, nb));
+                            start = first + na;
+                        }
+                        (_, Some((m, _))) => {
+                            let total = m + n;
+                            let (na, nb) = (total - total / 2, total / 2);
+                            let k = ahead.len();
+                            ahead[k - 1] = (na, span_of(start, na));
+                            ahead[k - 2] = (nb, span_of(start + na, nb));
+                        }
                         _ => {
-                            i += 1;
+                            done.push((n, sp));
+                            ahead.pop();
+                            start += n;
                             continue;
                         }
-                    };
-                    let total = sizes[a] + sizes[b];
-                    let start: usize = sizes[..a].iter().sum();
-                    // The earlier group keeps the larger half.
-                    sizes[b] = total / 2;
-                    sizes[a] = total - total / 2;
-                    span[a] = course_span(&courses[start..start + sizes[a]]);
-                    span[b] = course_span(&courses[start + sizes[a]..start + total]);
+                    }
                     changed = true;
                 }
             }
         }
+        (sizes, span) = done.into_iter().unzip();
         if !changed {
             return sizes;
         }

@@ -57,7 +57,12 @@ impl Layout<'_> {
                 .iter()
                 .enumerate()
                 .any(|(i, (_, a))| news[..i].iter().any(|(_, b)| a.bbox.intersects(&b.bbox)));
-            if overlap {
+            // Every piece on a course's start (see [`super::layout::phase`]).
+            if overlap
+                || news
+                    .iter()
+                    .any(|(pl, _)| pl.origin.z.rem_euclid(self.phase) != 0)
+            {
                 continue;
             }
             let ok = news.iter().all(|(pl, b)| {

@@ -114,6 +114,9 @@ impl Layout<'_> {
             .collect();
         for &i in body {
             let p = self.pieces[i as usize];
+            if p.gone {
+                continue;
+            }
             // Grow the piece itself.
             if p.placement.part.spec().shape == Shape::Rect {
                 for s in &rects {
@@ -180,7 +183,10 @@ impl Layout<'_> {
         let mut tries = 0;
         for &h in body {
             let hb = self.pieces[h as usize].body;
-            if self.pieces[h as usize].placement.part.spec().shape != Shape::Rect {
+            // A piece an earlier repair of this round took out is gone.
+            if self.pieces[h as usize].gone
+                || self.pieces[h as usize].placement.part.spec().shape != Shape::Rect
+            {
                 continue;
             }
             let mut others: Vec<u32> = Vec::new();
@@ -195,8 +201,8 @@ impl Layout<'_> {
                         let wb = self.pieces[w as usize].body;
                         if roots[w as usize] != root
                             && !others.contains(&w)
-                            && wb.bbox.min.z == hb.bbox.min.z
-                            && wb.bbox.sz == hb.bbox.sz
+                            && wb.bbox.min.z < hb.bbox.min.z + hb.bbox.sz
+                            && hb.bbox.min.z < wb.bbox.min.z + wb.bbox.sz
                             && wb.is_box()
                         {
                             others.push(w);
@@ -280,32 +286,36 @@ impl Layout<'_> {
         ok
     }
 
-    /// The biggest brick over the model's free voxels in the layers of `a`
-    /// that reaches into the boxes of both `a` and `b`.
+    /// The biggest brick (or plate) over the model's free voxels in the
+    /// layers `a` and `b` share that reaches into the boxes of both.
     fn across(&self, a: &Body, b: &Body) -> Option<(Placement, Body)> {
         let mut best: Option<(i32, Placement, Body)> = None;
+        let ab = a.bbox;
+        let lo = ab.min.z.max(b.bbox.min.z);
+        let hi = (ab.min.z + ab.sz).min(b.bbox.min.z + b.bbox.sz);
         for shape in self.shapes.iter() {
             if shape.part.spec().shape != Shape::Rect {
                 continue;
             }
             let (fx, fy) = shape.part.spec().footprint(shape.rot);
-            let ab = a.bbox;
-            for ox in ab.min.x - fx + 1..ab.min.x + ab.sx {
-                for oy in ab.min.y - fy + 1..ab.min.y + ab.sy {
-                    let origin = Cell::new(ox, oy, ab.min.z);
-                    let body = shape.body_at(origin);
-                    if body.bbox.sz != ab.sz
-                        || !body.bbox.intersects(&ab)
-                        || !body.bbox.intersects(&b.bbox)
-                        || !body
-                            .cells()
-                            .all(|q| self.must.get(q) && self.owner_of(q).is_none())
-                    {
-                        continue;
-                    }
-                    let v = body.volume();
-                    if best.as_ref().is_none_or(|x| v > x.0) {
-                        best = Some((v, Placement::new(shape.part, origin, shape.rot), body));
+            let sz = shape.body_at(Cell::new(0, 0, 0)).bbox.sz;
+            for oz in (lo..=hi - sz).filter(|z| z.rem_euclid(self.phase) == 0) {
+                for ox in ab.min.x - fx + 1..ab.min.x + ab.sx {
+                    for oy in ab.min.y - fy + 1..ab.min.y + ab.sy {
+                        let origin = Cell::new(ox, oy, oz);
+                        let body = shape.body_at(origin);
+                        if !body.bbox.intersects(&ab)
+                            || !body.bbox.intersects(&b.bbox)
+                            || !body
+                                .cells()
+                                .all(|q| self.must.get(q) && self.owner_of(q).is_none())
+                        {
+                            continue;
+                        }
+                        let v = body.volume();
+                        if best.as_ref().is_none_or(|x| v > x.0) {
+                            best = Some((v, Placement::new(shape.part, origin, shape.rot), body));
+                        }
                     }
                 }
             }

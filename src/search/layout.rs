@@ -107,8 +107,10 @@ pub(crate) struct PieceShape {
     pub part: PartKind,
     pub rot: Rot,
     body: Body,
-    /// Filled cells of the bottom layer, relative to the origin.
-    bottom: Vec<Cell>,
+    /// Per layer `k` below [`phase`]`(rules)`: the filled cells of the
+    /// piece's layer `k`, relative to the origin (the cells by which it
+    /// can cover a voxel `k` layers above a course's start).
+    keys: Vec<Vec<Cell>>,
     /// Long side along x (`Some(true)`), along y, or square.
     long_x: Option<bool>,
     single: bool,
@@ -121,9 +123,31 @@ impl PieceShape {
     }
 }
 
+/// The layers every piece of `rules`' alphabet starts on a multiple of:
+/// the greatest common divisor of their heights in layers. With slopes
+/// (half-brick layers, every piece two layers tall) it is 2: a piece laid
+/// a layer off its course could never stud-connect to the pieces on the
+/// course, so every piece starts on one.
+pub(crate) fn phase(rules: &RuleSet) -> i32 {
+    let u = rules.layer_ldu();
+    let gcd = |mut a: i32, mut b: i32| {
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        a
+    };
+    rules
+        .alphabet()
+        .iter()
+        .map(|p| (p.spec().height_ldu() / u).max(1))
+        .fold(0, gcd)
+        .max(1)
+}
+
 /// Every distinct turn of every part of `rules`' alphabet.
 pub(crate) fn shapes(rules: &RuleSet) -> Vec<PieceShape> {
     let u = rules.layer_ldu();
+    let phase = phase(rules);
     let mut out: Vec<PieceShape> = Vec::new();
     for &part in rules.alphabet() {
         for rot in Rot::ALL {
@@ -132,13 +156,15 @@ pub(crate) fn shapes(rules: &RuleSet) -> Vec<PieceShape> {
                 continue;
             }
             let body = part.body(rot, Cell::new(0, 0, 0), u);
-            let bottom = body.cells().filter(|c| c.z == 0).collect();
+            let keys = (0..phase)
+                .map(|k| body.cells().filter(|c| c.z == k).collect())
+                .collect();
             let (fx, fy) = part.spec().footprint(rot);
             out.push(PieceShape {
                 part,
                 rot,
                 body,
-                bottom,
+                keys,
                 long_x: (fx != fy).then_some(fx > fy),
                 single: fx * fy == 1,
             });
@@ -215,6 +241,9 @@ pub(crate) struct Layout<'a> {
     pub layer_ldu: i32,
     /// Layers in a brick course.
     pub course: i32,
+    /// Every piece starts on a layer that is a multiple of this
+    /// ([`phase`]).
+    pub phase: i32,
     /// The voxels to cover.
     pub must: &'a VoxelGrid,
     /// Empty cells the surface passes through.
@@ -229,6 +258,10 @@ pub(crate) struct Layout<'a> {
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
     pub colors: Option<&'a [u16]>,
+    /// Whether a piece may cover surface voxels of any colours: for a
+    /// voxel that no piece of one colour covers (two colours a layer apart
+    /// under pieces two layers tall), rather than leaving it out.
+    any_colours: bool,
     /// Per colour label: whether some part of the rules is made in that
     /// colour. Where one is, a piece showing the colour must be made in it.
     made: Vec<bool>,
@@ -327,12 +360,14 @@ impl<'a> Layout<'a> {
             book: RuleBook::new(rules),
             layer_ldu,
             course: (24 / layer_ldu).max(1),
+            phase: phase(rules),
             must,
             near,
             slant,
             keep_empty: None,
             released: std::collections::HashSet::new(),
             colors: None,
+            any_colours: false,
             made,
             shapes,
             weights: Weights::default(),
@@ -561,7 +596,12 @@ impl<'a> Layout<'a> {
                 return;
             }
         }
-        let best = self.choose(c, &mut dice.rules);
+        let mut best = self.choose(c, &mut dice.rules);
+        if best.is_none() && self.colors.is_some() {
+            self.any_colours = true;
+            best = self.choose(c, &mut dice.rules);
+            self.any_colours = false;
+        }
         match best {
             Some(b) => {
                 self.repairs.extra_cells += b.extra;
@@ -602,8 +642,9 @@ impl<'a> Layout<'a> {
     fn best(&mut self, c: Cell, reach: Reach, rng: &mut impl Rng) -> Option<Candidate> {
         let mut best: Option<Candidate> = None;
         for s in 0..self.shapes.len() {
-            for k in 0..self.shapes[s].bottom.len() {
-                let key = self.shapes[s].bottom[k];
+            let layer = c.z.rem_euclid(self.phase) as usize;
+            for k in 0..self.shapes[s].keys[layer].len() {
+                let key = self.shapes[s].keys[layer][k];
                 let origin = c.offset(-key.x, -key.y, -key.z);
                 let Some(mut cand) = self.eval(s, origin, reach) else {
                     continue;
@@ -655,7 +696,7 @@ impl<'a> Layout<'a> {
                 if !self.free(q) {
                     return None;
                 }
-                if let Some(colors) = self.colors {
+                if let Some(colors) = self.colors.filter(|_| !self.any_colours) {
                     let l = colors.get(self.must.index(q)).copied().unwrap_or(0);
                     if l != 0 {
                         match labels.iter_mut().find(|(k, _)| *k == l || *k == 0) {
@@ -702,17 +743,41 @@ impl<'a> Layout<'a> {
         if !open().all(|q| self.free(q) && !self.must.get(q)) {
             return false;
         }
+        // Nor may the model go on over the face (under it, underneath): a
+        // piece there would stand on no stud and shut the slope in.
+        let spec = p.part.spec();
+        let up = spec.shape == Shape::Slope;
+        let dz = if up { 1 } else { -1 };
+        if open().any(|q| {
+            let n = q.offset(0, 0, dz);
+            !b.bbox.contains(n) && self.must.in_bounds(n) && (self.must.get(n) || !self.free(n))
+        }) {
+            return false;
+        }
         let Some(slant) = self.slant else {
             return true;
         };
-        let spec = p.part.spec();
         let (bx, by) = spec.back(p.rot);
-        let up = spec.shape == Shape::Slope;
         let Some(g) = slant.facing((-bx, -by), up) else {
             return true;
         };
         let inward = if up { -1 } else { 1 };
         open().any(|q| (0..=depth).any(|k| g.get(q.offset(0, 0, inward * k))))
+    }
+
+    /// Whether a piece's box lies right under the box `b` somewhere (a
+    /// slope's open cells count as its own).
+    fn on_a_piece(&self, b: &crate::geom::CellBox) -> bool {
+        let z = b.min.z - 1;
+        (b.min.y..b.min.y + b.sy).any(|y| {
+            (b.min.x..b.min.x + b.sx).any(|x| {
+                let q = Cell::new(x, y, z);
+                self.owner_of(q).is_some()
+                    || self
+                        .owner_of(q.offset(0, 0, -1))
+                        .is_some_and(|o| self.pieces[o as usize].body.bbox.contains(q))
+            })
+        })
     }
 
     /// The pieces `body` rests on (their studs in its tubes), each once.
@@ -765,6 +830,13 @@ impl<'a> Layout<'a> {
             }
         }
         if !below.is_empty() && rule_w.is_none() {
+            return None;
+        }
+        // A piece that rests on nothing may hang from the pieces laid over
+        // it later, but only with room under it to come in from: standing
+        // on a piece it does not join (on a slope's face), it could be put
+        // in place neither before its piece above nor after.
+        if below.is_empty() && origin.z > 0 && self.on_a_piece(&body.bbox) {
             return None;
         }
         let mut score = w.size * inside as f64 - w.near * near as f64 - w.far * far as f64;
@@ -881,6 +953,7 @@ impl<'a> Layout<'a> {
         let id = self.pieces.len() as u32;
         for q in body.cells() {
             let i = self.must.index(q);
+            debug_assert_eq!(self.owner[i], NONE, "a piece laid over another at {q:?}");
             self.owner[i] = id;
         }
         self.pieces.push(Laid {
@@ -931,6 +1004,10 @@ impl<'a> Layout<'a> {
         let body = p.body;
         for q in body.cells() {
             let i = self.must.index(q);
+            debug_assert_eq!(
+                self.owner[i], NONE,
+                "a piece put back over another at {q:?}"
+            );
             self.owner[i] = id;
         }
     }

@@ -380,10 +380,12 @@ pub fn build_guided(
     }
     // The shell is taken of the repaired voxels, so that thickened sheets
     // and joined islands are measured as the model they are.
+    let phase = layout::phase(rules);
     let emptied = opts.hollow.map(|wall| {
         let h = crate::voxel::hollow(&fixed, wall, course, min_thick);
-        fixed = h.shell;
-        h.emptied
+        let (shell, emptied) = whole_courses(h.shell, h.emptied, phase);
+        fixed = shell;
+        emptied
     });
 
     let mut layout = layout::Layout::new(rules, &fixed, guide.surface, guide.slant);
@@ -467,6 +469,33 @@ pub fn build_guided(
         emptied,
         stats,
     })
+}
+
+/// A hollow's `emptied` cells cut to whole courses of `phase` layers
+/// (every piece starts on a course, see [`layout::phase`]): a cell is left
+/// empty only with its whole course's column empty, else it goes back to
+/// the `shell`, so that no voxel of the shell lies alone in a course with
+/// the hollow over or under it, where no piece could cover it.
+fn whole_courses(
+    mut shell: VoxelGrid,
+    mut emptied: VoxelGrid,
+    phase: i32,
+) -> (VoxelGrid, VoxelGrid) {
+    if phase <= 1 {
+        return (shell, emptied);
+    }
+    let partial: Vec<_> = emptied
+        .cells()
+        .filter(|c| {
+            let base = c.z - c.z.rem_euclid(phase);
+            (0..phase).any(|k| !emptied.get(crate::geom::Cell::new(c.x, c.y, base + k)))
+        })
+        .collect();
+    for c in partial {
+        emptied.set(c, false);
+        shell.set(c, true);
+    }
+    (shell, emptied)
 }
 
 /// Rounds of repairs of pieces that no order puts in place: fills of the
