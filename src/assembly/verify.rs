@@ -223,7 +223,7 @@ pub fn verify(asm: &Assembly, target: Option<&VoxelGrid>) -> VerifyReport {
         .collect();
 
     let neighbours = connections(&bodies);
-    let mut occupied = Occupied::default();
+    let mut occupied = Occupied::new(&boxes);
     let ground = boxes.iter().map(|b| b.min.z).min().unwrap_or(0);
     for (i, b) in boxes.iter().enumerate() {
         if i > 0 && b.min.z != ground && !neighbours[i].iter().any(|&j| j < i) {
@@ -408,31 +408,95 @@ fn check_cover(bodies: &[Body], target: &VoxelGrid) -> Option<Failure> {
     })
 }
 
-/// The cells of the pieces placed so far, with their bounding box.
-#[derive(Debug, Default)]
+/// The cells of the pieces placed so far, with their bounding box: a
+/// dense grid over the boxes of every piece that may be added.
+#[derive(Debug)]
 struct Occupied {
-    cells: HashSet<Cell>,
-    /// Inclusive minimum and maximum corners; `None` while empty.
+    /// The grid's minimum corner and size.
+    origin: Cell,
+    dims: (i32, i32, i32),
+    taken: Vec<bool>,
+    /// Inclusive minimum and maximum corners of the cells taken; `None`
+    /// while empty.
     bounds: Option<(Cell, Cell)>,
 }
 
 impl Occupied {
+    /// Nothing taken yet, in a grid over the boxes `all` (those that may
+    /// be added).
+    fn new<'a>(all: impl IntoIterator<Item = &'a CellBox>) -> Occupied {
+        let mut ext: Option<(Cell, Cell)> = None;
+        for b in all {
+            let m = b.max_excl();
+            ext = Some(match ext {
+                None => (b.min, m),
+                Some((l, h)) => (lowest(l, b.min), highest(h, m)),
+            });
+        }
+        let (origin, hi) = ext.unwrap_or((Cell::new(0, 0, 0), Cell::new(0, 0, 0)));
+        let dims = (hi.x - origin.x, hi.y - origin.y, hi.z - origin.z);
+        Occupied {
+            origin,
+            dims,
+            taken: vec![false; (dims.0 * dims.1 * dims.2).max(0) as usize],
+            bounds: None,
+        }
+    }
+
+    /// The part of `b` within the grid, as index ranges, or `None`.
+    fn clip(&self, b: &CellBox) -> Option<[std::ops::Range<i32>; 3]> {
+        let o = self.origin;
+        let (nx, ny, nz) = self.dims;
+        let r = |lo: i32, len: i32, n: i32| (lo.max(0))..((lo + len).min(n));
+        let ranges = [
+            r(b.min.x - o.x, b.sx, nx),
+            r(b.min.y - o.y, b.sy, ny),
+            r(b.min.z - o.z, b.sz, nz),
+        ];
+        ranges.iter().all(|r| !r.is_empty()).then_some(ranges)
+    }
+
     fn add(&mut self, b: &CellBox) {
-        self.cells.extend(b.cells());
+        let (nx, ny, _) = self.dims;
+        if let Some([xs, ys, zs]) = self.clip(b) {
+            for z in zs {
+                for y in ys.clone() {
+                    for x in xs.clone() {
+                        self.taken[((z * ny + y) * nx + x) as usize] = true;
+                    }
+                }
+            }
+        }
         let hi = b.max_excl().offset(-1, -1, -1);
         self.bounds = Some(match self.bounds {
             None => (b.min, hi),
-            Some((l, h)) => (
-                Cell::new(l.x.min(b.min.x), l.y.min(b.min.y), l.z.min(b.min.z)),
-                Cell::new(h.x.max(hi.x), h.y.max(hi.y), h.z.max(hi.z)),
-            ),
+            Some((l, h)) => (lowest(l, b.min), highest(h, hi)),
         });
     }
 
     /// Whether any cell of `b` is occupied (an empty box has none).
     fn any_in(&self, b: &CellBox) -> bool {
-        b.sz > 0 && b.cells().any(|c| self.cells.contains(&c))
+        let (nx, ny, _) = self.dims;
+        let Some([xs, ys, zs]) = self.clip(b) else {
+            return false;
+        };
+        zs.into_iter().any(|z| {
+            ys.clone().any(|y| {
+                let row = ((z * ny + y) * nx) as usize;
+                self.taken[row + xs.start as usize..row + xs.end as usize].contains(&true)
+            })
+        })
     }
+}
+
+/// The corner of the lowest coordinates of `a` and `b`.
+fn lowest(a: Cell, b: Cell) -> Cell {
+    Cell::new(a.x.min(b.x), a.y.min(b.y), a.z.min(b.z))
+}
+
+/// The corner of the highest coordinates of `a` and `b`.
+fn highest(a: Cell, b: Cell) -> Cell {
+    Cell::new(a.x.max(b.x), a.y.max(b.y), a.z.max(b.z))
 }
 
 /// The pieces (but those in `skip`) whose box, at their turn,
@@ -553,7 +617,7 @@ fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
 /// Whether a piece with box `b` can be put in place after the pieces with
 /// boxes `earlier` (the placeability rule of the module docs, alone).
 pub fn placeable_after(earlier: &[CellBox], b: &CellBox) -> bool {
-    let mut occ = Occupied::default();
+    let mut occ = Occupied::new(earlier.iter().chain([b]));
     for e in earlier {
         occ.add(e);
     }
@@ -623,7 +687,7 @@ fn escapes(b: &CellBox, occ: &Occupied, lo: Cell, hi: Cell) -> bool {
     if !free(b.min) {
         return false;
     }
-    let mut seen = HashSet::from([b.min]);
+    let mut seen = crate::geom::CellSet::from_iter([b.min]);
     let mut queue = VecDeque::from([b.min]);
     while let Some(p) = queue.pop_front() {
         if outside(p) {

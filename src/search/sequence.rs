@@ -30,7 +30,7 @@
 //! repair (a pillar under it) and order again.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashSet, VecDeque};
+use std::collections::{BinaryHeap, VecDeque};
 
 use super::layout::Layout;
 use super::{Anchor, Removal};
@@ -317,7 +317,13 @@ impl State {
                         || hold.reaches_start(q, g.holds, g.starts, present, g.z)
                 })
             };
-            let leaves = if !joined || !holds_on() {
+            // The cheap tests first: the search down to a start may
+            // visit thousands of pieces.
+            let leaves = if !joined {
+                Err(Watch::Near)
+            } else if !self.space.joins_outside(&g.boxes[k]) {
+                Err(Watch::Cavity)
+            } else if !holds_on() {
                 Err(Watch::Near)
             } else {
                 self.space.can_leave(&g.boxes[k])
@@ -609,19 +615,24 @@ impl Space {
     /// its cells join the outside, and it travels out of the bounding box
     /// of the other cells taken; if not, what to watch for a change.
     fn can_leave(&mut self, b: &CellBox) -> Result<(), Watch> {
-        let joins_outside = b.cells().any(|c| {
-            FACES.iter().any(|&(dx, dy, dz)| {
-                let n = c.offset(dx, dy, dz);
-                !b.contains(n) && self.index(n).is_some_and(|j| self.outside[j])
-            })
-        });
-        if !joins_outside {
+        if !self.joins_outside(b) {
             return Err(Watch::Cavity);
         }
         self.count(b, false);
         let out = self.escapes(b);
         self.count(b, true);
         out
+    }
+
+    /// Whether a cell of box `b` has a face on the free space joined to
+    /// the outside.
+    fn joins_outside(&self, b: &CellBox) -> bool {
+        b.cells().any(|c| {
+            FACES.iter().any(|&(dx, dy, dz)| {
+                let n = c.offset(dx, dy, dz);
+                !b.contains(n) && self.index(n).is_some_and(|j| self.outside[j])
+            })
+        })
     }
 
     /// The verifier's placeability rule on the taken cells; if the piece
@@ -670,7 +681,7 @@ impl Space {
             };
             !self.any_taken(&layer(p.z + b.sz)) && !self.any_taken(&layer(p.z - 1))
         };
-        let mut seen = HashSet::from([b.min]);
+        let mut seen = crate::geom::CellSet::from_iter([b.min]);
         let mut queue = VecDeque::from([b.min]);
         let (mut plo, mut phi) = (b.min, b.min);
         while let Some(p) = queue.pop_front() {
