@@ -7,6 +7,16 @@
 
 use serde::Serialize;
 
+/// The six face neighbours' offsets of a cell: along x, y, then z.
+pub const FACES: [(i32, i32, i32); 6] = [
+    (1, 0, 0),
+    (-1, 0, 0),
+    (0, 1, 0),
+    (0, -1, 0),
+    (0, 0, 1),
+    (0, 0, -1),
+];
+
 /// A set of cells hashed cheaply (the standard hasher resists attacks
 /// that cell coordinates cannot mount, at several times the cost): the
 /// placeability searches test millions of cells.

@@ -544,14 +544,7 @@ fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
     let mut queue: Vec<Cell> = Vec::new();
     let flood = |queue: &mut Vec<Cell>, outside: &mut Vec<bool>, taken: &[u32]| {
         while let Some(c) = queue.pop() {
-            for (dx, dy, dz) in [
-                (1, 0, 0),
-                (-1, 0, 0),
-                (0, 1, 0),
-                (0, -1, 0),
-                (0, 0, 1),
-                (0, 0, -1),
-            ] {
+            for (dx, dy, dz) in crate::geom::FACES {
                 let n = c.offset(dx, dy, dz);
                 if let Some(i) = index(n) {
                     if taken[i] == 0 && !outside[i] {
@@ -590,16 +583,9 @@ fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
             if taken[i] > 0 || outside[i] {
                 continue;
             }
-            let touches = [
-                (1, 0, 0),
-                (-1, 0, 0),
-                (0, 1, 0),
-                (0, -1, 0),
-                (0, 0, 1),
-                (0, 0, -1),
-            ]
-            .iter()
-            .any(|&(dx, dy, dz)| index(c.offset(dx, dy, dz)).is_some_and(|j| outside[j]));
+            let touches = crate::geom::FACES
+                .iter()
+                .any(|&(dx, dy, dz)| index(c.offset(dx, dy, dz)).is_some_and(|j| outside[j]));
             if touches {
                 outside[i] = true;
                 queue.push(c);

@@ -34,7 +34,7 @@ use std::collections::{BinaryHeap, VecDeque};
 
 use super::layout::Layout;
 use super::{Anchor, Removal};
-use crate::geom::{Cell, CellBox};
+use crate::geom::{Cell, CellBox, FACES};
 use crate::grammar::{Dir, RuleRef};
 
 /// Positions a piece's escape search visits at most before the piece is
@@ -49,16 +49,6 @@ const HOLD_LIMIT: usize = 4_096;
 /// piece whose going opens a cavity to the outside, and every this many
 /// pieces in any case (the pieces left take less room).
 const RETRY_ALL: usize = 256;
-
-/// The six face neighbours.
-const FACES: [(i32, i32, i32); 6] = [
-    (1, 0, 0),
-    (-1, 0, 0),
-    (0, 1, 0),
-    (0, -1, 0),
-    (0, 0, 1),
-    (0, 0, -1),
-];
 
 /// Reorders `order` (a derivation of the pieces of `l`) so that every piece
 /// can be put in place at its turn; returns the new order and the positions

@@ -23,7 +23,7 @@ use glam::Vec3;
 
 use super::{to_grid_frame, Up, VoxelGrid, VoxelModel};
 use crate::catalog::{buildable, lab, Color, COLORS};
-use crate::geom::Cell;
+use crate::geom::{Cell, FACES};
 use crate::mesh::{paint::linear_to_srgb, Mesh};
 
 /// The colours of a model's voxels.
@@ -234,7 +234,7 @@ fn spread(grid: &VoxelGrid, cells: &mut [Option<Color>]) {
     }
     while let Some(c) = queue.pop_front() {
         let color = cells[grid.index(c)];
-        for (dx, dy, dz) in NEIGHBOURS {
+        for (dx, dy, dz) in FACES {
             let n = c.offset(dx, dy, dz);
             if grid.in_bounds(n) && grid.get(n) && cells[grid.index(n)].is_none() {
                 cells[grid.index(n)] = color;
@@ -258,20 +258,11 @@ fn spread(grid: &VoxelGrid, cells: &mut [Option<Color>]) {
     }
 }
 
-const NEIGHBOURS: [(i32, i32, i32); 6] = [
-    (1, 0, 0),
-    (-1, 0, 0),
-    (0, 1, 0),
-    (0, -1, 0),
-    (0, 0, 1),
-    (0, 0, -1),
-];
-
 /// Per cell: filled with an empty or out-of-grid face neighbour.
 fn surface_cells(grid: &VoxelGrid) -> Vec<bool> {
     let mut out = vec![false; grid.len()];
     for c in grid.cells() {
-        out[grid.index(c)] = NEIGHBOURS.iter().any(|&(dx, dy, dz)| {
+        out[grid.index(c)] = FACES.iter().any(|&(dx, dy, dz)| {
             let n = c.offset(dx, dy, dz);
             !grid.in_bounds(n) || !grid.get(n)
         });

@@ -68,14 +68,7 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> boo
         if seen.len() > MAX_VISITED {
             return false;
         }
-        for (dx, dy, dz) in [
-            (1, 0, 0),
-            (-1, 0, 0),
-            (0, 1, 0),
-            (0, -1, 0),
-            (0, 0, 1),
-            (0, 0, -1),
-        ] {
+        for (dx, dy, dz) in crate::geom::FACES {
             let n = Cell::new(m.x + dx, m.y + dy, m.z + dz);
             if seen.contains(&n) {
                 continue;

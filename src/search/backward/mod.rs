@@ -99,14 +99,7 @@ fn one_piece(v: &VoxelGrid) -> bool {
     let mut n = 0;
     while let Some(c) = stack.pop() {
         n += 1;
-        for d in [
-            (1, 0, 0),
-            (-1, 0, 0),
-            (0, 1, 0),
-            (0, -1, 0),
-            (0, 0, 1),
-            (0, 0, -1),
-        ] {
+        for d in crate::geom::FACES {
             let e = Cell::new(c.x + d.0, c.y + d.1, c.z + d.2);
             if v.in_bounds(e) && v.get(e) && !seen.get(e) {
                 seen.set(e, true);

@@ -663,14 +663,7 @@ impl<'a> Trace<'a> {
         while let Some(c) = stack.pop() {
             n += 1;
             let mine = owner(c);
-            for (dx, dy, dz) in [
-                (1, 0, 0),
-                (-1, 0, 0),
-                (0, 1, 0),
-                (0, -1, 0),
-                (0, 0, 1),
-                (0, 0, -1),
-            ] {
+            for (dx, dy, dz) in crate::geom::FACES {
                 let d = c.offset(dx, dy, dz);
                 if !self.left.in_bounds(d) || !self.left.get(d) || seen.get(d) {
                     continue;
