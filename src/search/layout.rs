@@ -744,15 +744,29 @@ impl<'a> Layout<'a> {
             return false;
         }
         // Nor may the model go on over the face (under it, underneath): a
-        // piece there would stand on no stud and shut the slope in.
+        // piece there would stand on no stud and shut the slope in. On
+        // top, that is over every column of the box with no stud (a 33°
+        // slope's middle row is filled but slants too).
         let spec = p.part.spec();
         let up = spec.shape == Shape::Slope;
         let dz = if up { 1 } else { -1 };
+        let blocked = |n: Cell| self.must.in_bounds(n) && (self.must.get(n) || !self.free(n));
         if open().any(|q| {
             let n = q.offset(0, 0, dz);
-            !b.bbox.contains(n) && self.must.in_bounds(n) && (self.must.get(n) || !self.free(n))
+            !b.bbox.contains(n) && blocked(n)
         }) {
             return false;
+        }
+        if up {
+            let top = b.bbox.min.z + b.bbox.sz - 1;
+            let bare = (b.bbox.min.y..b.bbox.min.y + b.bbox.sy).any(|y| {
+                (b.bbox.min.x..b.bbox.min.x + b.bbox.sx).any(|x| {
+                    !b.studs.contains(Cell::new(x, y, top)) && blocked(Cell::new(x, y, top + 1))
+                })
+            });
+            if bare {
+                return false;
+            }
         }
         let Some(slant) = self.slant else {
             return true;
