@@ -59,13 +59,16 @@ pub fn render_all(
 ) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
-    let step_images = if steps {
+    // The step images, the finished model and the exploded view are
+    // independent: drawn side by side, no core waits for the others.
+    let views = || finished_views(p.assembly, &renderer);
+    let (step_images, views) = if steps {
         let total = p.assembly.step_count() as u64;
         // The images are drawn on worker threads; each finished one is
         // counted here, on the caller's thread.
         let (tx, rx) = std::sync::mpsc::channel::<()>();
         std::thread::scope(|s| {
-            let worker = s.spawn(|| step_images(&renderer, tx));
+            let worker = s.spawn(|| rayon::join(|| step_images(&renderer, tx), views));
             let mut done = 0;
             for () in rx {
                 done += 1;
@@ -76,20 +79,29 @@ pub fn render_all(
                 .unwrap_or_else(|e| std::panic::resume_unwind(e))
         })
     } else {
-        Vec::new()
+        (Vec::new(), views())
     };
+    let (model, exploded) = views?;
     // A camera's scale is pixels an LDU; a stud is 20 LDU across.
     let step_scales = (0..step_images.len())
         .map(|n| renderer.step_camera(n).scale() * 20.0)
         .collect();
-    let model = renderer.model_image();
-    let exploded = exploded_view(p.assembly, &model)?;
     Ok(Rendered {
         steps: step_images,
         step_scales,
         model,
         exploded,
     })
+}
+
+/// The finished model and the exploded view, drawn side by side.
+fn finished_views(
+    assembly: &Assembly,
+    renderer: &StepRenderer,
+) -> Result<(RgbaImage, RgbaImage), RenderError> {
+    let (model, exploded) = rayon::join(|| renderer.model_image(), || exploded_alone(assembly));
+    let exploded = exploded_view(&model, &exploded?);
+    Ok((model, exploded))
 }
 
 /// Every step image, drawn incrementally in as many runs as threads; a
@@ -113,10 +125,9 @@ fn step_images(renderer: &StepRenderer, drawn: std::sync::mpsc::Sender<()>) -> V
         .collect()
 }
 
-/// The exploded view (pieces pulled apart course by course, see
-/// [`explode`]) with the finished model above it, a third of its size
-/// (portrait, as a booklet page is).
-fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, RenderError> {
+/// The exploded view alone: the pieces pulled apart course by course (see
+/// [`explode`]).
+fn exploded_alone(assembly: &Assembly) -> Result<RgbaImage, RenderError> {
     let offsets = explode(assembly, &ExplodeOptions::default());
     let mut scene = Scene::new();
     for (p, off) in assembly.pieces.iter().zip(&offsets) {
@@ -124,16 +135,21 @@ fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, Re
         at.translation += glam::Vec3A::from(*off);
         scene.add_part(p.placement.part, at, p.color, p.step);
     }
-    let opts = options();
-    let (w, h) = (opts.width, opts.height);
     // Only the finished picture is drawn: no step framing (zoom) to work
     // out, as it never changes that picture.
-    let exploded = StepRenderer::new(scene, &opts.with_zoom(false))?.model_image();
+    Ok(StepRenderer::new(scene, &options().with_zoom(false))?.model_image())
+}
+
+/// The exploded view (see [`exploded_alone`]) with the finished model
+/// above it, a third of its size (portrait, as a booklet page is).
+fn exploded_view(model: &RgbaImage, exploded: &RgbaImage) -> RgbaImage {
+    let opts = options();
+    let (w, h) = (opts.width, opts.height);
     let small = image::imageops::resize(model, w / 3, h / 3, image::imageops::FilterType::Triangle);
     let mut out = RgbaImage::from_pixel(w, h + h / 3, image::Rgba([255, 255, 255, 255]));
     image::imageops::overlay(&mut out, &small, i64::from(w - w / 3), 0);
-    image::imageops::overlay(&mut out, &exploded, 0, i64::from(h / 3));
-    Ok(out)
+    image::imageops::overlay(&mut out, exploded, 0, i64::from(h / 3));
+    out
 }
 
 /// PNG bytes of every image, encoded in parallel.
