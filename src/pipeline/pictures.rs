@@ -59,16 +59,17 @@ pub fn render_all(
 ) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
-    // The step images, the finished model and the exploded view are
-    // independent: drawn side by side, no core waits for the others.
-    let views = || finished_views(p.assembly, &renderer);
-    let (step_images, views) = if steps {
+    // The exploded view is drawn beside the step images; the finished
+    // model is composed from the buffer the last step leaves, when that
+    // step is seen as the model is.
+    let exploded = || exploded_alone(p.assembly);
+    let ((step_images, finished), exploded) = if steps {
         let total = p.assembly.step_count() as u64;
         // The images are drawn on worker threads; each finished one is
         // counted here, on the caller's thread.
         let (tx, rx) = std::sync::mpsc::channel::<()>();
         std::thread::scope(|s| {
-            let worker = s.spawn(|| rayon::join(|| step_images(&renderer, tx), views));
+            let worker = s.spawn(|| rayon::join(|| step_images(&renderer, tx), exploded));
             let mut done = 0;
             for () in rx {
                 done += 1;
@@ -79,9 +80,10 @@ pub fn render_all(
                 .unwrap_or_else(|e| std::panic::resume_unwind(e))
         })
     } else {
-        (Vec::new(), views())
+        ((Vec::new(), None), exploded())
     };
-    let (model, exploded) = views?;
+    let model = renderer.model_image_from(finished);
+    let exploded = exploded_view(&model, &exploded?);
     // A camera's scale is pixels an LDU; a stud is 20 LDU across.
     let step_scales = (0..step_images.len())
         .map(|n| renderer.step_camera(n).scale() * 20.0)
@@ -94,35 +96,35 @@ pub fn render_all(
     })
 }
 
-/// The finished model and the exploded view, drawn side by side.
-fn finished_views(
-    assembly: &Assembly,
-    renderer: &StepRenderer,
-) -> Result<(RgbaImage, RgbaImage), RenderError> {
-    let (model, exploded) = rayon::join(|| renderer.model_image(), || exploded_alone(assembly));
-    let exploded = exploded_view(&model, &exploded?);
-    Ok((model, exploded))
-}
-
 /// Every step image, drawn incrementally in as many runs as threads; a
-/// message on `drawn` for each.
-fn step_images(renderer: &StepRenderer, drawn: std::sync::mpsc::Sender<()>) -> Vec<RgbaImage> {
-    renderer
+/// message on `drawn` for each. With them, the buffer the last step
+/// leaves (see [`StepImages::into_finished`](render::StepImages)).
+fn step_images(
+    renderer: &StepRenderer,
+    drawn: std::sync::mpsc::Sender<()>,
+) -> (Vec<RgbaImage>, Option<render::Finished>) {
+    let runs: Vec<(Vec<RgbaImage>, Option<render::Finished>)> = renderer
         .runs()
         .into_par_iter()
         .map(|r| {
-            renderer
-                .images_in(r)
+            let mut images = renderer.images_in(r);
+            let drawn: Vec<RgbaImage> = images
+                .by_ref()
                 .map(|(_, img)| {
                     let _ = drawn.send(());
                     img
                 })
-                .collect::<Vec<_>>()
+                .collect();
+            (drawn, images.into_finished())
         })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .collect()
+        .collect();
+    let mut finished = None;
+    let mut all = Vec::new();
+    for (images, last) in runs {
+        all.extend(images);
+        finished = finished.or(last);
+    }
+    (all, finished)
 }
 
 /// The exploded view alone: the pieces pulled apart course by course (see
