@@ -84,7 +84,8 @@ fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
             return 0;
         }
         let (fi, fj) = (s.face[i], s.face[j]);
-        let crease = fi[..3] != fj[..3] && {
+        // The normals compared as three bytes, not as slices (a call).
+        let crease = [fi[0], fi[1], fi[2]] != [fj[0], fj[1], fj[2]] && {
             let dot: i32 = (0..3)
                 .map(|k| i32::from(fi[k] as i8) * i32::from(fj[k] as i8))
                 .sum();
