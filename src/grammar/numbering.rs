@@ -18,6 +18,7 @@ use std::collections::HashMap;
 use crate::catalog::PartKind;
 use crate::geom::Rot;
 
+use super::keyhash::KeyMap;
 use super::{Dir, RuleRef, RuleSet, Variant};
 
 /// What identifies a basic rule whatever the layer height: a turn of it,
@@ -39,7 +40,7 @@ fn key(v: &Variant) -> BasicKey {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Numbering {
     starts: Vec<PartKind>,
-    basic: HashMap<BasicKey, u32>,
+    basic: KeyMap<BasicKey, u32>,
     basic_count: u32,
     complex: Vec<String>,
 }
@@ -49,7 +50,7 @@ impl Numbering {
     pub(super) fn of(set: &RuleSet) -> Numbering {
         let starts: Vec<PartKind> = set.starts.iter().map(|s| s.part).collect();
         let first = starts.len() as u32;
-        let mut basic = HashMap::new();
+        let mut basic = KeyMap::default();
         for v in &set.variants {
             basic.entry(key(v)).or_insert(first + v.rule.0);
         }

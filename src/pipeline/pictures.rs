@@ -59,13 +59,17 @@ pub fn render_all(
 ) -> Result<Rendered, RenderError> {
     let opts = options();
     let renderer = render::renderer(p.assembly, &opts)?;
-    let step_images = if steps {
+    // The exploded view is drawn beside the step images; the finished
+    // model is composed from the buffer the last step leaves, when that
+    // step is seen as the model is.
+    let exploded = || exploded_alone(p.assembly);
+    let ((step_images, finished), exploded) = if steps {
         let total = p.assembly.step_count() as u64;
         // The images are drawn on worker threads; each finished one is
         // counted here, on the caller's thread.
         let (tx, rx) = std::sync::mpsc::channel::<()>();
         std::thread::scope(|s| {
-            let worker = s.spawn(|| step_images(&renderer, tx));
+            let worker = s.spawn(|| rayon::join(|| step_images(&renderer, tx), exploded));
             let mut done = 0;
             for () in rx {
                 done += 1;
@@ -76,14 +80,14 @@ pub fn render_all(
                 .unwrap_or_else(|e| std::panic::resume_unwind(e))
         })
     } else {
-        Vec::new()
+        ((Vec::new(), None), exploded())
     };
+    let model = renderer.model_image_from(finished);
+    let exploded = exploded_view(&model, &exploded?);
     // A camera's scale is pixels an LDU; a stud is 20 LDU across.
     let step_scales = (0..step_images.len())
         .map(|n| renderer.step_camera(n).scale() * 20.0)
         .collect();
-    let model = renderer.model_image();
-    let exploded = exploded_view(p.assembly, &model)?;
     Ok(Rendered {
         steps: step_images,
         step_scales,
@@ -93,30 +97,39 @@ pub fn render_all(
 }
 
 /// Every step image, drawn incrementally in as many runs as threads; a
-/// message on `drawn` for each.
-fn step_images(renderer: &StepRenderer, drawn: std::sync::mpsc::Sender<()>) -> Vec<RgbaImage> {
-    renderer
+/// message on `drawn` for each. With them, the buffer the last step
+/// leaves (see [`StepImages::into_finished`](render::StepImages)).
+fn step_images(
+    renderer: &StepRenderer,
+    drawn: std::sync::mpsc::Sender<()>,
+) -> (Vec<RgbaImage>, Option<render::Finished>) {
+    let runs: Vec<(Vec<RgbaImage>, Option<render::Finished>)> = renderer
         .runs()
         .into_par_iter()
         .map(|r| {
-            renderer
-                .images_in(r)
+            let mut images = renderer.images_in(r);
+            let drawn: Vec<RgbaImage> = images
+                .by_ref()
                 .map(|(_, img)| {
                     let _ = drawn.send(());
                     img
                 })
-                .collect::<Vec<_>>()
+                .collect();
+            (drawn, images.into_finished())
         })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .collect()
+        .collect();
+    let mut finished = None;
+    let mut all = Vec::new();
+    for (images, last) in runs {
+        all.extend(images);
+        finished = finished.or(last);
+    }
+    (all, finished)
 }
 
-/// The exploded view (pieces pulled apart course by course, see
-/// [`explode`]) with the finished model above it, a third of its size
-/// (portrait, as a booklet page is).
-fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, RenderError> {
+/// The exploded view alone: the pieces pulled apart course by course (see
+/// [`explode`]).
+fn exploded_alone(assembly: &Assembly) -> Result<RgbaImage, RenderError> {
     let offsets = explode(assembly, &ExplodeOptions::default());
     let mut scene = Scene::new();
     for (p, off) in assembly.pieces.iter().zip(&offsets) {
@@ -124,16 +137,21 @@ fn exploded_view(assembly: &Assembly, model: &RgbaImage) -> Result<RgbaImage, Re
         at.translation += glam::Vec3A::from(*off);
         scene.add_part(p.placement.part, at, p.color, p.step);
     }
-    let opts = options();
-    let (w, h) = (opts.width, opts.height);
     // Only the finished picture is drawn: no step framing (zoom) to work
     // out, as it never changes that picture.
-    let exploded = StepRenderer::new(scene, &opts.with_zoom(false))?.model_image();
+    Ok(StepRenderer::new(scene, &options().with_zoom(false))?.model_image())
+}
+
+/// The exploded view (see [`exploded_alone`]) with the finished model
+/// above it, a third of its size (portrait, as a booklet page is).
+fn exploded_view(model: &RgbaImage, exploded: &RgbaImage) -> RgbaImage {
+    let opts = options();
+    let (w, h) = (opts.width, opts.height);
     let small = image::imageops::resize(model, w / 3, h / 3, image::imageops::FilterType::Triangle);
     let mut out = RgbaImage::from_pixel(w, h + h / 3, image::Rgba([255, 255, 255, 255]));
     image::imageops::overlay(&mut out, &small, i64::from(w - w / 3), 0);
-    image::imageops::overlay(&mut out, &exploded, 0, i64::from(h / 3));
-    Ok(out)
+    image::imageops::overlay(&mut out, exploded, 0, i64::from(h / 3));
+    out
 }
 
 /// PNG bytes of every image, encoded in parallel.

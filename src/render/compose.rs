@@ -84,7 +84,8 @@ fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
             return 0;
         }
         let (fi, fj) = (s.face[i], s.face[j]);
-        let crease = fi[..3] != fj[..3] && {
+        // The normals compared as three bytes, not as slices (a call).
+        let crease = [fi[0], fi[1], fi[2]] != [fj[0], fj[1], fj[2]] && {
             let dot: i32 = (0..3)
                 .map(|k| i32::from(fi[k] as i8) * i32::from(fj[k] as i8))
                 .sum();
@@ -188,6 +189,10 @@ pub(crate) fn compose(
     let old_line_on_dark = fade(LINE_ON_DARK, style.fade);
     for py in rect.y0..rect.y1 {
         for px in rect.x0..rect.x1 {
+            if let Some(px_out) = uniform(samples, &lines, (ex0, ey0, ew), (px, py), looks, style) {
+                out.put_pixel(px, py, image::Rgba(px_out));
+                continue;
+            }
             let (mut sr, mut sg, mut sb, mut opaque) = (0u32, 0u32, 0u32, 0u32);
             for sy in py as usize * ss..(py as usize + 1) * ss {
                 for sx in px as usize * ss..(px as usize + 1) * ss {
@@ -241,6 +246,60 @@ pub(crate) fn compose(
             out.put_pixel(px, py, image::Rgba(px_out));
         }
     }
+}
+
+/// The pixel `(px, py)` when its samples are all alike: no line, one
+/// piece (or the background) and one shade, so their average is the one
+/// colour they share, exactly as the general loop computes it (`n`
+/// equal values `c` average to `(n c + n / 2) / n = c`). `None` otherwise,
+/// or when the pixel reaches past the samples' edge. `lines` covers the
+/// samples from `(ex0, ey0)`, `ew` a row.
+#[inline]
+fn uniform(
+    samples: &Samples,
+    lines: &[u8],
+    (ex0, ey0, ew): (usize, usize, usize),
+    (px, py): (u32, u32),
+    looks: &[PieceLook],
+    style: &Style,
+) -> Option<[u8; 4]> {
+    let (ss, w) = (samples.ss, samples.w);
+    let (x0, y0) = (px as usize * ss, py as usize * ss);
+    if x0 + ss > w || y0 + ss > samples.h {
+        return None;
+    }
+    let first = y0 * w + x0;
+    let p = samples.piece[first];
+    let shade = samples.face[first][3];
+    for sy in y0..y0 + ss {
+        let row = sy * w;
+        let line_row = (sy - ey0) * ew;
+        for sx in x0..x0 + ss {
+            let i = row + sx;
+            if lines[line_row + sx - ex0] != 0 || samples.piece[i] != p {
+                return None;
+            }
+            if p != EMPTY && samples.face[i][3] != shade {
+                return None;
+            }
+        }
+    }
+    Some(match looks.get(p as usize) {
+        Some(l) => {
+            let shade = u32::from(shade);
+            let lit = l.rgb.map(|v| ((u32::from(v) * shade + 127) / 255) as u8);
+            let [r, g, b] = if l.class == class::OLD {
+                fade(lit, style.fade)
+            } else {
+                lit
+            };
+            [r, g, b, 255]
+        }
+        None => {
+            let [r, g, b, a] = style.background;
+            [r, g, b, if a == 0 { 0 } else { 255 }]
+        }
+    })
 }
 
 /// Thickens lines: each sample takes the highest class within `radius`

@@ -123,6 +123,7 @@ use crate::catalog::{Color, PartKind};
 pub use camera::{Camera, View};
 pub use raster::PixelRect;
 pub use scene::{Scene, ScenePiece, Triangle};
+pub(crate) use steps::Finished;
 pub use steps::{write_png, StepImages, StepRenderer};
 pub use stress::{draw_stress_legend, stress_color};
 pub use turn::Turning;

@@ -233,6 +233,12 @@ impl Samples {
         let e0 = setup(b2, c2);
         let e1 = setup(c2, a2);
         let e2 = setup(a2, b2);
+        // Each edge's 1 / A, for narrowing the rows: a row's bounds only
+        // need to be within the slack (a sample and more) of the exact
+        // crossing, which a reciprocal's rounding stays far inside, and
+        // divisions a row cost more than the rest of a small triangle.
+        let inverse = |e: (f32, f32, f32, bool)| if e.0 == 0.0 { 0.0 } else { 1.0 / e.0 };
+        let inv = [inverse(e0), inverse(e1), inverse(e2)];
         for y in y0..y1 {
             let py = y as f32 + 0.5;
             let row = y * self.w;
@@ -245,7 +251,7 @@ impl Samples {
             // slack each side; the exact tests below decide), so long thin
             // triangles cost their area, not their bounding box.
             let (mut lo, mut hi) = (x0 as f32, x1 as f32);
-            for (e, r) in [(e0, r0), (e1, r1), (e2, r2)] {
+            for ((e, r), inv) in [(e0, r0), (e1, r1), (e2, r2)].into_iter().zip(inv) {
                 let ea = e.0;
                 if ea == 0.0 {
                     continue;
@@ -253,8 +259,8 @@ impl Samples {
                 // Where the edge crosses the row, give or take the rounding
                 // of `r` divided by a possibly small slope (nearly
                 // horizontal edges), plus a sample.
-                let cross = -r / ea - 0.5;
-                let slack = 1.0 + (e.1.abs() * py + e.2.abs() + ea.abs() * hi) * 1e-6 / ea.abs();
+                let cross = -r * inv - 0.5;
+                let slack = 1.0 + (e.1.abs() * py + e.2.abs() + ea.abs() * hi) * 1e-6 * inv.abs();
                 if ea > 0.0 {
                     lo = lo.max(floor(cross - slack));
                 } else {

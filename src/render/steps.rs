@@ -331,10 +331,28 @@ impl StepRenderer {
 
     /// The finished model, every piece plain (none faded or highlighted).
     pub fn model_image(&self) -> RgbaImage {
-        let mut samples = self.samples();
-        for n in 0..self.steps.len() {
-            self.draw_step(&mut samples, n, &self.eyes[0]);
-        }
+        self.model_image_from(None)
+    }
+
+    /// The finished model as [`model_image`](Self::model_image) draws it,
+    /// from the buffer the step images left (see
+    /// [`StepImages::into_finished`]) when it holds every step seen through
+    /// the base camera: the last step's view is the finished model's
+    /// unless it turned, and drawing the model again costs as much as
+    /// every step image. The samples are the same as drawn afresh (the
+    /// same camera, the same pieces in the same order), so the image is
+    /// too.
+    pub(crate) fn model_image_from(&self, finished: Option<Finished>) -> RgbaImage {
+        let samples = match finished {
+            Some(f) if f.camera == *self.camera() => f.samples,
+            _ => {
+                let mut samples = self.samples();
+                for n in 0..self.steps.len() {
+                    self.draw_step(&mut samples, n, &self.eyes[0]);
+                }
+                samples
+            }
+        };
         let mut img = self.blank();
         let full = PixelRect {
             x0: 0,
@@ -452,6 +470,14 @@ pub fn write_png(img: &RgbaImage, alpha: bool, w: &mut dyn Write) -> io::Result<
 /// and 2 x 2 samples).
 const KEPT_EYES: usize = 4;
 
+/// Every step drawn through one camera: what [`StepImages`] leaves once
+/// it has handed out the last step's image.
+#[derive(Debug)]
+pub(crate) struct Finished {
+    camera: Camera,
+    samples: Samples,
+}
+
 /// A sample buffer kept for an eye: everything up to a step drawn
 /// through it.
 #[derive(Debug)]
@@ -513,6 +539,24 @@ impl<'a> StepImages<'a> {
         }
         kept.drawn = n + 1;
         self.kept.insert(0, kept);
+    }
+}
+
+impl StepImages<'_> {
+    /// The buffer of the last step's view once the iterator has handed
+    /// out the last step's image (it then holds every step); `None`
+    /// before, or for a range that stops short of the last step.
+    pub(crate) fn into_finished(mut self) -> Option<Finished> {
+        let r = &*self.renderer;
+        let last = r.steps.len();
+        if self.next != last || self.kept.first().is_none_or(|k| k.drawn != last) {
+            return None;
+        }
+        let kept = self.kept.swap_remove(0);
+        Some(Finished {
+            camera: self.renderer.eyes[kept.eye].camera,
+            samples: kept.samples,
+        })
     }
 }
 

@@ -431,3 +431,22 @@ fn pieces_take_the_colours_they_are_given() {
         "{e}"
     );
 }
+
+#[test]
+fn the_model_composed_from_the_last_steps_buffer_is_the_one_drawn_afresh() {
+    // A model whose last step is seen as the model is (the buffer is
+    // used), and one whose last step turns (it is not): the same image
+    // either way.
+    for scene in [little_model(), wall_then_behind()] {
+        let r = StepRenderer::new(scene, &opts().with_size(320, 240)).unwrap();
+        let mut images = r.images();
+        for _ in images.by_ref() {}
+        let finished = images.into_finished();
+        assert!(r.model_image_from(finished) == r.model_image());
+    }
+    // A range short of the last step leaves nothing to reuse.
+    let r = StepRenderer::new(wall_then_behind(), &opts().with_size(320, 240)).unwrap();
+    let mut images = r.images_in(0..1);
+    for _ in images.by_ref() {}
+    assert!(images.into_finished().is_none());
+}
