@@ -17,37 +17,9 @@ pub const FACES: [(i32, i32, i32); 6] = [
     (0, 0, -1),
 ];
 
-/// A set of cells hashed cheaply (the standard hasher resists attacks
-/// that cell coordinates cannot mount, at several times the cost): the
+/// A set of cells hashed cheaply (see [`crate::keyhash`]): the
 /// placeability searches test millions of cells.
-pub type CellSet = std::collections::HashSet<Cell, std::hash::BuildHasherDefault<CellHasher>>;
-
-/// The hasher of [`CellSet`]: a multiply-rotate mix of each integer
-/// written (the scheme of rustc's FxHash).
-#[derive(Debug, Default, Clone, Copy)]
-pub struct CellHasher(u64);
-
-impl CellHasher {
-    fn mix(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-}
-
-impl std::hash::Hasher for CellHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.mix(u64::from(b));
-        }
-    }
-
-    fn write_i32(&mut self, i: i32) {
-        self.mix(u64::from(i as u32));
-    }
-}
+pub(crate) type CellSet = crate::keyhash::KeySet<Cell>;
 
 /// A voxel cell (or a piece's minimum corner) in grid coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]

@@ -33,6 +33,7 @@ pub mod export;
 pub mod fsutil;
 pub mod geom;
 pub mod grammar;
+mod keyhash;
 pub mod ldraw;
 pub mod mesh;
 pub mod physics;

@@ -34,7 +34,6 @@
 pub mod complex;
 mod cover;
 mod defaults;
-mod keyhash;
 pub mod learn;
 mod numbering;
 mod parse;
@@ -398,7 +397,7 @@ impl RuleSet {
                 v.dir,
             )
         };
-        let mut seen: keyhash::KeySet<Key> = self.variants.iter().map(key).collect();
+        let mut seen: crate::keyhash::KeySet<Key> = self.variants.iter().map(key).collect();
         let parts = self.alphabet.clone();
         for &a in &parts {
             for &b in &parts {

@@ -18,8 +18,8 @@ use std::collections::HashMap;
 use crate::catalog::PartKind;
 use crate::geom::Rot;
 
-use super::keyhash::KeyMap;
 use super::{Dir, RuleRef, RuleSet, Variant};
+use crate::keyhash::KeyMap;
 
 /// What identifies a basic rule whatever the layer height: a turn of it,
 /// without the vertical offset (which depends on the layers).

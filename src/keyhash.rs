@@ -1,4 +1,5 @@
-//! A fast hasher for the rule tables' small keys.
+//! A fast hasher for small keys the program makes itself: the rule
+//! tables' and the grid cells the placeability searches visit.
 //!
 //! Loading a rule file turns every rule and generates the unseen ones,
 //! checking each turned rule against the ones already made: hundreds of
