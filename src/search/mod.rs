@@ -396,11 +396,18 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
-    let swaps = if opts.cap_stairs {
+    let mut swaps = if opts.cap_stairs {
         layout.cap_stairs()
     } else {
         Vec::new()
     };
+    // Nor may they split the build: a swap keeps its own joints, but two
+    // swaps side by side can take both ends of the one piece that joined
+    // two parts.
+    if !swaps.is_empty() && layout.bodies().len() > 1 {
+        layout.uncap(&swaps);
+        swaps.clear();
+    }
     let (mut order, mut unreached) = derive(&layout);
     let mut blocked = unplaceable(&order, rules.layer_ldu());
     // Slopes capping the stairs must not cost the build its order: if a
