@@ -620,26 +620,36 @@ fn placeable(b: &CellBox, occ: &Occupied) -> bool {
     let Some((lo, hi)) = occ.bounds else {
         return true;
     };
-    // Fast path: a straight drop from above or press from below.
-    let above = CellBox {
-        min: Cell::new(b.min.x, b.min.y, b.min.z + b.sz),
-        sz: (hi.z + 1 - (b.min.z + b.sz)).max(0),
-        ..*b
-    };
-    let below = CellBox {
-        min: Cell::new(b.min.x, b.min.y, lo.z),
-        sz: (b.min.z - lo.z).max(0),
-        ..*b
-    };
-    if !occ.any_in(&above) || !occ.any_in(&below) {
-        return true;
-    }
-    escapes(b, occ, lo, hi)
+    matches!(
+        escape(b, lo, hi, |x| occ.any_in(x), usize::MAX),
+        Escape::Out
+    )
 }
 
-/// The breadth-first search: can `b` travel to a position whose box lies
-/// outside the bounding box `lo..=hi` of the occupied cells?
-fn escapes(b: &CellBox, occ: &Occupied, lo: Cell, hi: Cell) -> bool {
+/// What [`escape`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Escape {
+    /// The piece travels out of the bounding box.
+    Out,
+    /// It cannot (or the search stopped at its limit); the inclusive
+    /// corners of the positions it reached.
+    Stuck(Cell, Cell),
+}
+
+/// Whether the piece in box `b` travels out of the bounding box `lo..=hi`
+/// of the occupied cells (`taken` says whether a box meets one) by the
+/// moves of the module docs: straight up or down, sideways one stud at a
+/// time with its studs clear. A breadth-first search of its positions
+/// that visits at most `limit` of them; from each, the straight ways out
+/// (up, down, sideways) are tried first, as the search would find them
+/// after a wide sweep of the free space around.
+pub(crate) fn escape(
+    b: &CellBox,
+    lo: Cell,
+    hi: Cell,
+    taken: impl Fn(&CellBox) -> bool,
+    limit: usize,
+) -> Escape {
     let outside = |p: Cell| {
         p.x + b.sx <= lo.x
             || p.x > hi.x
@@ -659,27 +669,52 @@ fn escapes(b: &CellBox, occ: &Occupied, lo: Cell, hi: Cell) -> bool {
             && (rmin.y..=rmax.y).contains(&p.y)
             && (rmin.z..=rmax.z).contains(&p.z)
     };
-    let free = |p: Cell| !occ.any_in(&moved(b, p));
+    let free = |p: Cell| !taken(&moved(b, p));
+    // The piece's footprint at `p`, layers `z0..z1`.
+    let column = |p: Cell, z0: i32, z1: i32| CellBox {
+        min: Cell::new(p.x, p.y, z0),
+        sz: (z1 - z0).max(0),
+        ..*b
+    };
     // Stud clearance: nothing just above or just below the box.
     let clear = |p: Cell| {
-        let layer = |z| CellBox {
-            min: Cell::new(p.x, p.y, z),
-            sz: 1,
-            ..*b
-        };
-        !occ.any_in(&layer(p.z + b.sz)) && !occ.any_in(&layer(p.z - 1))
+        !taken(&column(p, p.z + b.sz, p.z + b.sz + 1)) && !taken(&column(p, p.z - 1, p.z))
     };
-
     if !free(b.min) {
-        return false;
+        return Escape::Stuck(b.min, b.min);
     }
     let mut seen = crate::geom::CellSet::from_iter([b.min]);
     let mut queue = VecDeque::from([b.min]);
+    let (mut plo, mut phi) = (b.min, b.min);
     while let Some(p) = queue.pop_front() {
         if outside(p) {
-            return true;
+            return Escape::Out;
+        }
+        if seen.len() > limit {
+            break;
+        }
+        plo = Cell::new(plo.x.min(p.x), plo.y.min(p.y), plo.z.min(p.z));
+        phi = Cell::new(phi.x.max(p.x), phi.y.max(p.y), phi.z.max(p.z));
+        // A straight drop from above or press from below.
+        if !taken(&column(p, p.z + b.sz, hi.z + 1)) || !taken(&column(p, lo.z, p.z)) {
+            return Escape::Out;
         }
         let clear_here = clear(p);
+        // Straight sideways out, studs clear all the way.
+        if clear_here {
+            for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+                let mut q = p;
+                loop {
+                    if outside(q) {
+                        return Escape::Out;
+                    }
+                    q = q.offset(dx, dy, 0);
+                    if !free(q) || !clear(q) {
+                        break;
+                    }
+                }
+            }
+        }
         let moves = [
             (0, 0, 1, false),
             (0, 0, -1, false),
@@ -700,7 +735,7 @@ fn escapes(b: &CellBox, occ: &Occupied, lo: Cell, hi: Cell) -> bool {
             queue.push_back(q);
         }
     }
-    false
+    Escape::Stuck(plo, phi)
 }
 
 #[cfg(test)]

@@ -30,10 +30,11 @@
 //! repair (a pillar under it) and order again.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::BinaryHeap;
 
 use super::layout::Layout;
 use super::{Anchor, Removal};
+use crate::assembly::verify::{escape, Escape};
 use crate::geom::{Cell, CellBox, FACES};
 use crate::grammar::{Dir, RuleRef};
 
@@ -44,11 +45,6 @@ const ESCAPE_LIMIT: usize = 2_048;
 /// Pieces visited at most when checking that a piece is still held by a
 /// chain of rules down to the ground; past it, the piece is taken as held.
 const HOLD_LIMIT: usize = 4_096;
-
-/// A waiting unit is tried again when a piece over or under it goes, or a
-/// piece whose going opens a cavity to the outside, and every this many
-/// pieces in any case (the pieces left take less room).
-const RETRY_ALL: usize = 256;
 
 /// Reorders `order` (a derivation of the pieces of `l`) so that every piece
 /// can be put in place at its turn; returns the new order and the positions
@@ -151,31 +147,21 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
     // Per waiting unit: whether what it waits for may have changed since
     // it last tried, and what that is.
     let mut dirty: Vec<bool> = vec![false; units.len()];
-    let mut watch: Vec<Watch> = vec![Watch::Near; units.len()];
-    let reach: Vec<CellBox> = units.iter().map(|u| around(u, &boxes)).collect();
-    let mut since_all = 0usize;
+    let mut watch: Vec<Watch> = vec![Watch::Never; units.len()];
+    let near: Vec<CellBox> = units.iter().map(|u| around(u, &boxes)).collect();
+    let mut bounds = state.space.bounds();
     loop {
+        // The latest waiting unit whose watch fired and that can go now.
         let mut went = None;
-        // The units whose watch fired; all of them every RETRY_ALL pieces,
-        // and when nothing else can go.
-        for sweep in [since_all >= RETRY_ALL, true] {
-            if sweep {
-                since_all = 0;
-            }
-            for (i, &w) in waiting.iter().enumerate() {
-                if sweep || std::mem::take(&mut dirty[w]) {
-                    dirty[w] = false;
-                    match state.take_out(&units[w], &graph) {
-                        Ok(()) => {
-                            went = Some(i);
-                            break;
-                        }
-                        Err(why) => watch[w] = why,
+        for (i, &w) in waiting.iter().enumerate() {
+            if std::mem::take(&mut dirty[w]) {
+                match state.take_out(&units[w], &graph) {
+                    Ok(()) => {
+                        went = Some(i);
+                        break;
                     }
+                    Err(why) => watch[w] = why,
                 }
-            }
-            if went.is_some() || sweep || !fresh.is_empty() {
-                break;
             }
         }
         let unit = if let Some(i) = went {
@@ -191,24 +177,30 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
         } else if waiting.is_empty() {
             break;
         } else {
-            // Nothing left can go: the latest waiting unit goes by force.
+            // Nothing left can go (every watch is exact: a unit whose
+            // watch did not fire would fail again): the latest waiting
+            // unit goes by force.
             let w = waiting.remove(0);
             for &k in units[w].iter().rev() {
                 state.present[k] = false;
-                state.space.remove(&boxes[k]);
+                let opened = state.space.remove(&boxes[k]);
+                state.opened_cavity |= opened.len() > boxes[k].cells().count();
                 state.anchors[k] = best_anchor(&holds[k], &state.present);
             }
             forced.push(w);
             w
         };
         taken_out.push(unit);
-        since_all += 1;
         let cavity = std::mem::take(&mut state.opened_cavity);
+        let now = state.space.bounds();
+        let shrunk = now != bounds;
+        bounds = now;
         for &w in &waiting {
             dirty[w] |= match watch[w] {
-                Watch::Near => overlaps_across(&reach[w], &reach[unit]),
-                Watch::Cavity => cavity,
-                Watch::Region(r) => units[unit].iter().any(|&k| meets(&r, &boxes[k])),
+                Watch::Never => false,
+                Watch::Piece(q) => units[unit].contains(&(q as usize)),
+                Watch::Cavity => cavity || units[unit].iter().any(|&k| meets(&near[w], &boxes[k])),
+                Watch::Region(r) => shrunk || units[unit].iter().any(|&k| meets(&r, &boxes[k])),
             };
         }
     }
@@ -242,15 +234,24 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
     (out, forced_at)
 }
 
-/// Why a unit could not go yet: what must change before it is tried
-/// again.
+/// Why a unit could not go yet: what must change before it can. Each is
+/// exact (pieces only go): a unit is tried again only when what it
+/// watches changed, and one whose watch did not fire would fail again.
 #[derive(Debug, Clone, Copy)]
 enum Watch {
-    /// It or a piece it holds: a piece over, under or beside it must go.
-    Near,
-    /// Its cells are shut off from the outside: a cavity must open.
+    /// No rule joins it to a piece left, and none ever will (a piece's
+    /// anchors only go).
+    Never,
+    /// Taking it out leaves this piece without a chain of rules to the
+    /// ground, and so will taking it out later (chains only break): the
+    /// piece must go first.
+    Piece(u32),
+    /// Its cells are shut off from the outside: free space beside it must
+    /// join the outside (a piece beside it goes, or a cavity opens).
     Cavity,
-    /// Its way out is blocked within this box: a piece there must go.
+    /// Its way out is blocked within this box (or by the bounding box of
+    /// the pieces left): a piece there must go, or the bounding box
+    /// shrink.
     Region(CellBox),
 }
 
@@ -300,21 +301,21 @@ impl State {
             // What it holds (but its own unit) still hangs on the ground
             // through the pieces left.
             let (present, hold) = (&self.present, &mut self.hold);
-            let mut holds_on = || {
-                g.held[k].iter().all(|&q| {
-                    !present[q as usize]
-                        || unit.contains(&(q as usize))
-                        || hold.reaches_start(q, g.holds, g.starts, present, g.z)
+            let mut dropped = || {
+                g.held[k].iter().copied().find(|&q| {
+                    present[q as usize]
+                        && !unit.contains(&(q as usize))
+                        && !hold.reaches_start(q, g.holds, g.starts, present, g.z)
                 })
             };
             // The cheap tests first: the search down to a start may
             // visit thousands of pieces.
             let leaves = if !joined {
-                Err(Watch::Near)
+                Err(Watch::Never)
             } else if !self.space.joins_outside(&g.boxes[k]) {
                 Err(Watch::Cavity)
-            } else if !holds_on() {
-                Err(Watch::Near)
+            } else if let Some(q) = dropped() {
+                Err(Watch::Piece(q))
             } else {
                 self.space.can_leave(&g.boxes[k])
             };
@@ -340,7 +341,7 @@ impl State {
     }
 }
 
-/// The box around a unit's pieces, one stud wider on every side.
+/// The box around a unit's pieces, one cell wider on every side.
 fn around(unit: &[usize], boxes: &[CellBox]) -> CellBox {
     let (mut lo, mut hi) = (boxes[unit[0]].min, boxes[unit[0]].max_excl());
     for &k in unit {
@@ -349,20 +350,11 @@ fn around(unit: &[usize], boxes: &[CellBox]) -> CellBox {
         hi = Cell::new(hi.x.max(b.x), hi.y.max(b.y), hi.z.max(b.z));
     }
     CellBox {
-        min: lo.offset(-1, -1, 0),
+        min: lo.offset(-1, -1, -1),
         sx: hi.x - lo.x + 2,
         sy: hi.y - lo.y + 2,
-        sz: hi.z - lo.z,
+        sz: hi.z - lo.z + 2,
     }
-}
-
-/// Whether the footprints of `a` and `b` overlap, at any height: a piece
-/// going from over or under a piece can free its way.
-fn overlaps_across(a: &CellBox, b: &CellBox) -> bool {
-    a.min.x < b.min.x + b.sx
-        && b.min.x < a.min.x + a.sx
-        && a.min.y < b.min.y + b.sy
-        && b.min.y < a.min.y + a.sy
 }
 
 /// Whether boxes `a` and `b` share a cell.
@@ -422,33 +414,36 @@ impl Hold {
         z: &[i32],
     ) -> bool {
         // The chain found last time, if every piece of it is still there
-        // (a real chain: the search below would say yes too).
+        // (a real chain: the search below would say yes too). Where it
+        // breaks, its pieces up to the break are still joined to `q`: the
+        // search goes on from all of them, and mends the chain.
+        self.stamp += 1;
+        let stamp = self.stamp;
+        let mut queue = BinaryHeap::new();
         let mut p = q;
         for _ in 0..HOLD_LIMIT {
-            if !present[p as usize] {
+            if !present[p as usize] || self.seen[p as usize] == stamp {
                 break;
             }
             if starts[p as usize] {
                 return true;
             }
+            self.seen[p as usize] = stamp;
+            self.from[p as usize] = u32::MAX;
+            queue.push(Reverse((z[p as usize], p)));
             p = self.next[p as usize];
             if p == u32::MAX {
                 break;
             }
         }
-        self.stamp += 1;
-        let stamp = self.stamp;
         // Lowest first: a chain down to the ground is found in about as
         // many steps as the piece stands high.
-        let mut queue = BinaryHeap::from([Reverse((z[q as usize], q))]);
-        self.seen[q as usize] = stamp;
-        self.from[q as usize] = u32::MAX;
         let mut visited = 0;
         while let Some(Reverse((_, p))) = queue.pop() {
             if starts[p as usize] {
                 // Keep the chain for next time.
                 let mut c = p;
-                while c != q {
+                while self.from[c as usize] != u32::MAX {
                     let f = self.from[c as usize];
                     self.next[f as usize] = c;
                     c = f;
@@ -665,85 +660,20 @@ impl Space {
         let Some((lo, hi)) = self.bounds() else {
             return Ok(());
         };
-        let above = CellBox {
-            min: Cell::new(b.min.x, b.min.y, b.min.z + b.sz),
-            sz: (hi.z + 1 - (b.min.z + b.sz)).max(0),
-            ..*b
-        };
-        let below = CellBox {
-            min: Cell::new(b.min.x, b.min.y, lo.z),
-            sz: (b.min.z - lo.z).max(0),
-            ..*b
-        };
-        if !self.any_taken(&above) || !self.any_taken(&below) {
-            return Ok(());
-        }
-        let outside = |p: Cell| {
-            p.x + b.sx <= lo.x
-                || p.x > hi.x
-                || p.y + b.sy <= lo.y
-                || p.y > hi.y
-                || p.z + b.sz <= lo.z
-                || p.z > hi.z
-        };
-        let (rmin, rmax) = (
-            lo.offset(-b.sx - 1, -b.sy - 1, -b.sz - 1),
-            hi.offset(1, 1, 1),
-        );
-        let in_region = |p: Cell| {
-            (rmin.x..=rmax.x).contains(&p.x)
-                && (rmin.y..=rmax.y).contains(&p.y)
-                && (rmin.z..=rmax.z).contains(&p.z)
-        };
-        let at = |p: Cell| CellBox { min: p, ..*b };
-        let free = |p: Cell| !self.any_taken(&at(p));
-        let clear = |p: Cell| {
-            let layer = |z| CellBox {
-                min: Cell::new(p.x, p.y, z),
-                sz: 1,
-                ..*b
-            };
-            !self.any_taken(&layer(p.z + b.sz)) && !self.any_taken(&layer(p.z - 1))
-        };
-        let mut seen = crate::geom::CellSet::from_iter([b.min]);
-        let mut queue = VecDeque::from([b.min]);
-        let (mut plo, mut phi) = (b.min, b.min);
-        while let Some(p) = queue.pop_front() {
-            if outside(p) {
-                return Ok(());
-            }
-            if seen.len() > ESCAPE_LIMIT {
-                break;
-            }
-            plo = Cell::new(plo.x.min(p.x), plo.y.min(p.y), plo.z.min(p.z));
-            phi = Cell::new(phi.x.max(p.x), phi.y.max(p.y), phi.z.max(p.z));
-            let clear_here = clear(p);
-            for (dx, dy, dz, sideways) in [
-                (0, 0, 1, false),
-                (0, 0, -1, false),
-                (1, 0, 0, true),
-                (-1, 0, 0, true),
-                (0, 1, 0, true),
-                (0, -1, 0, true),
-            ] {
-                let q = p.offset(dx, dy, dz);
-                if !in_region(q) || seen.contains(&q) || !free(q) {
-                    continue;
-                }
-                if sideways && !(clear_here && clear(q)) {
-                    continue;
-                }
-                seen.insert(q);
-                queue.push_back(q);
+        match escape(b, lo, hi, |x| self.any_taken(x), ESCAPE_LIMIT) {
+            Escape::Out => Ok(()),
+            // What blocks it lies within a cell of the positions explored
+            // (the layers over and under them for the studs' clearance),
+            // or in the columns over and under it, up to the bounding box.
+            Escape::Stuck(plo, phi) => {
+                let (zlo, zhi) = ((plo.z - 2).min(lo.z), (phi.z + b.sz + 2).max(hi.z + 1));
+                Err(Watch::Region(CellBox {
+                    min: Cell::new(plo.x - 1, plo.y - 1, zlo),
+                    sx: phi.x - plo.x + b.sx + 2,
+                    sy: phi.y - plo.y + b.sy + 2,
+                    sz: zhi - zlo,
+                }))
             }
         }
-        // What blocks it lies within a cell of the positions explored
-        // (the layers over and under them for the studs' clearance).
-        Err(Watch::Region(CellBox {
-            min: plo.offset(-1, -1, -2),
-            sx: phi.x - plo.x + b.sx + 2,
-            sy: phi.y - plo.y + b.sy + 2,
-            sz: phi.z - plo.z + b.sz + 4,
-        }))
     }
 }
