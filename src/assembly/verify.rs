@@ -600,16 +600,6 @@ fn enclosed(boxes: &[CellBox], skip: &HashSet<usize>) -> Vec<usize> {
     shut
 }
 
-/// Whether a piece with box `b` can be put in place after the pieces with
-/// boxes `earlier` (the placeability rule of the module docs, alone).
-pub fn placeable_after(earlier: &[CellBox], b: &CellBox) -> bool {
-    let mut occ = Occupied::new(earlier.iter().chain([b]));
-    for e in earlier {
-        occ.add(e);
-    }
-    !occ.any_in(b) && placeable(b, &occ)
-}
-
 /// The box `b` moved to minimum corner `min`.
 fn moved(b: &CellBox, min: Cell) -> CellBox {
     CellBox { min, ..*b }

@@ -99,9 +99,6 @@ pub(super) struct JobWindow<'a> {
     reused: usize,
     /// The made steps' jobs not yet taken, by step.
     jobs: std::collections::BTreeMap<usize, Vec<Job>>,
-    /// `(step, job)` of the jobs that need a solve if everything before
-    /// stood (the common case): solved up front, a batch of steps at once.
-    ahead: Vec<(usize, usize)>,
 }
 
 impl<'a> JobWindow<'a> {
@@ -115,7 +112,6 @@ impl<'a> JobWindow<'a> {
             made: 0,
             reused: 0,
             jobs: std::collections::BTreeMap::new(),
-            ahead: Vec::new(),
         }
     }
 
@@ -124,15 +120,6 @@ impl<'a> JobWindow<'a> {
         while self.made < upto.min(self.bounds.len()) {
             let k = self.made;
             let jobs = self.advance(k);
-            let begin = if k == 0 { 0 } else { self.bounds[k - 1].1 };
-            let end = self.bounds[k].1;
-            if k > self.k0 || self.k0 == 0 {
-                for (j, job) in jobs.iter().enumerate() {
-                    if !(job.grounded && drops(self.s, job, begin, end)) {
-                        self.ahead.push((k, j));
-                    }
-                }
-            }
             self.jobs.insert(k, jobs);
             self.made += 1;
         }
@@ -164,20 +151,9 @@ impl<'a> JobWindow<'a> {
         jobs
     }
 
-    /// `(step, job)` of the jobs made that need a solve.
-    pub(super) fn ahead(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        self.ahead.iter().copied()
-    }
-
-    /// Job `j` of step `k`, made and not taken.
-    pub(super) fn job(&self, k: usize, j: usize) -> &Job {
-        &self.jobs[&k][j]
-    }
-
     /// The jobs of step `k` (made), for the check to use; earlier steps'
     /// are dropped.
     pub(super) fn take(&mut self, k: usize) -> Vec<Job> {
-        self.ahead.retain(|&(s, _)| s > k);
         while let Some(first) = self.jobs.first_key_value().map(|(&f, _)| f) {
             if first >= k {
                 break;

@@ -79,17 +79,29 @@
 //!
 //! # Steps
 //!
+//! A step **stands** when the pieces placed so far have an equilibrium
+//! under gravity with no hand force and every stud joint within its
+//! capacity (usage below 1). This is the safe theorem of rigid-block
+//! analysis: if the contacts can carry the loads in some way, the
+//! structure stands, whatever way the real forces choose. Any method may
+//! find such an equilibrium; a found one is checked against every
+//! equation and bound of its group, and that check is what says
+//! "stands".
+//!
 //! [`analyze_steps`] checks every intermediate build (the pieces of steps
 //! `1..=k`). It keeps a union-find of the groups as pieces are added; a
 //! group no piece of step `k` joined keeps its result from an earlier step.
 //! A group that stood and grew only by pieces whose weight goes straight
 //! down to the ground in compression (each point under the centre of mass
-//! lies on a face of the piece below, down to the ground) needs no solve
-//! either: adding that compression to the old forces is an equilibrium
-//! with the same clutch usage, a certificate that it still stands. Only
-//! the remaining groups are solved, a step's groups in parallel. (Clarabel
-//! is an interior-point solver with no warm start; this certificate is the
-//! reuse of the previous solution.) The finished build is solved afresh.
+//! lies on a face of the piece below, down to the ground) needs nothing
+//! more: that compression is added to the kept forces. For every other
+//! group the kept equilibrium is changed near the new pieces: a small
+//! program over the new pieces, a way down from each to the ground and
+//! a few rings of contacts around them, widened up to the whole group,
+//! where the program is exact: none found there, the step fails, and the
+//! group's force program below says which pieces fall or break off. The
+//! finished build is solved afresh with the force program, for the usage
+//! of every piece.
 //!
 //! Before any program is solved, the group gets a second, exact
 //! certificate: when every piece's weight can be passed down to the ground
@@ -120,6 +132,7 @@
 //! assert!(a.pieces[1].usage > 0.0 && a.pieces[1].usage < 1.0);
 //! ```
 
+mod certify;
 mod compression;
 mod groups;
 mod model;

@@ -23,11 +23,11 @@ const TENSION_COST: f64 = 1e-3;
 
 /// A horizontal rectangle in stud units: `[x0, x1] x [y0, y1]`.
 #[derive(Debug, Clone, Copy)]
-struct Rect {
-    x0: f64,
-    y0: f64,
-    x1: f64,
-    y1: f64,
+pub(super) struct Rect {
+    pub x0: f64,
+    pub y0: f64,
+    pub x1: f64,
+    pub y1: f64,
 }
 
 impl Rect {
@@ -40,7 +40,7 @@ impl Rect {
         }
     }
 
-    fn corners(&self) -> [(f64, f64); 4] {
+    pub fn corners(&self) -> [(f64, f64); 4] {
         [
             (self.x0, self.y0),
             (self.x1, self.y0),
@@ -70,36 +70,36 @@ pub(super) struct Contact {
     pub below: usize,
     pub above: usize,
     /// Where the faces press on each other (compression at its corners).
-    face: Option<Rect>,
+    pub face: Option<Rect>,
     /// The studs of `below` in `above`'s tubes, as cell centres.
-    studs: Vec<(f64, f64)>,
+    pub studs: Vec<(f64, f64)>,
 }
 
 /// One piece's load and its support by the ground.
 #[derive(Debug, Clone)]
-struct Load {
+pub(super) struct Load {
     /// Weight in clutch capacities of a stud.
-    weight: f64,
+    pub weight: f64,
     /// Centre of mass, in studs.
-    com: (f64, f64),
+    pub com: (f64, f64),
     /// The piece's bounding footprint (where a hand may hold it).
-    extent: Rect,
+    pub extent: Rect,
     /// Its bottom face on the ground, if it stands on it.
-    ground: Option<Rect>,
+    pub ground: Option<Rect>,
     /// Its tubes on a baseplate's studs ([`Ground::Baseplate`] only).
-    ground_studs: Vec<(f64, f64)>,
+    pub ground_studs: Vec<(f64, f64)>,
     /// The layer of its bottom.
-    z: i32,
+    pub z: i32,
 }
 
 /// The assembly seen as loads and contacts, built once.
 #[derive(Debug, Clone)]
 pub(super) struct Structure {
-    loads: Vec<Load>,
+    pub loads: Vec<Load>,
     /// Sorted by the later piece (`max(below, above)`), then by the pair.
     pub contacts: Vec<Contact>,
     /// Per piece, the contacts (indices) with a face under it.
-    under: Vec<Vec<usize>>,
+    pub under: Vec<Vec<usize>>,
 }
 
 impl Structure {

@@ -1,6 +1,7 @@
 //! The step check: the groups of touching pieces that grew at each step
-//! (see [`groups`](super::groups)) solved in parallel, a batch of steps at
-//! a time.
+//! (see [`groups`](super::groups)), each certified by an equilibrium
+//! changed from the step before near the new pieces (see
+//! [`certify`](super::certify)); a group with none is solved.
 
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
@@ -9,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::assembly::Assembly;
 
+use super::certify::{Certifier, Verdict};
 use super::compression;
 use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
 use super::model::{solve, Contact, Structure};
@@ -112,24 +114,6 @@ fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>
         .collect()
 }
 
-/// [`run_refs`], leaving out (`None`) each job that would start past
-/// `deadline`.
-fn run_within(
-    s: &Structure,
-    jobs: &[&Job],
-    params: &Params,
-    deadline: Option<Instant>,
-) -> Result<Vec<Option<Answer>>, PhysicsError> {
-    jobs.par_iter()
-        .map(|job| {
-            if past(deadline) {
-                return Ok(None);
-            }
-            run_refs(s, std::slice::from_ref(job), params).map(|mut r| r.pop())
-        })
-        .collect()
-}
-
 /// Every piece of the first `n` pieces, all groups solved (in parallel).
 pub(super) fn solve_all(
     s: &Structure,
@@ -182,10 +166,12 @@ fn solve_all_but(
 /// only pieces whose weight goes straight down to the ground in
 /// compression (each point under its centre of mass on a face of the piece
 /// below, down to the ground) still stands with the same
-/// clutch usage, the new pieces using none. Only the other groups are
-/// solved, in parallel (up to 16 steps ahead at once, so a check that
-/// stops at a failure may have solved a few steps past it). The finished
-/// build's groups are solved afresh, but for those whose program the last
+/// clutch usage, the new pieces using none. Every other group is
+/// certified (see [`certify`](super::certify)): the equilibrium kept from
+/// the step before, changed near the new pieces, checked against every
+/// equation and bound; its pieces' usage is that equilibrium's. A group for
+/// which none exists fails; it is solved, and its program's answer says
+/// which pieces fall or break off. The finished build's groups are solved afresh, but for those whose program the last
 /// step solved already, so [`StepsAnalysis::last`] is what
 /// [`analyze`](super::analyze) gives (and the last step's check agrees
 /// with it); with `stop_at_first_failure` and a failure, `last` is the
@@ -197,10 +183,6 @@ pub fn analyze_steps(
 ) -> Result<StepsAnalysis, PhysicsError> {
     analyze_steps_within(assembly, params, stop_at_first_failure, None)
 }
-
-/// Steps whose programs are solved together, in parallel, between looks
-/// at the deadline.
-const STEPS_A_BATCH: usize = 16;
 
 /// [`analyze_steps`] with a deadline: once it has passed, no further step
 /// is checked ([`StepsAnalysis::complete`] is false and `steps` ends at the
@@ -523,9 +505,6 @@ fn check_steps_in(
     let mut exact = vec![false; n];
     let mut steps = Vec::with_capacity(bounds.len());
     let mut first_failure = None;
-    // Every step's groups, and whether each needs a solve if everything
-    // before stood (the common case): those programs are solved up front,
-    // all steps in parallel.
     // The first step checked (the last one when `from` is past it): solved
     // whole, with every group.
     let k0 = bounds
@@ -533,7 +512,6 @@ fn check_steps_in(
         .position(|b| b.0 >= from)
         .unwrap_or(bounds.len().saturating_sub(1));
     let last_k = bounds.len().saturating_sub(1);
-    let first_batch = if k0 > 0 { k0 + 1 } else { 0 };
     // The steps' groups are made as the check reaches them, a batch ahead
     // at most: a group lists all its pieces, so keeping every step's at
     // once took memory growing with the square of the steps (a column of
@@ -545,12 +523,9 @@ fn check_steps_in(
         total: n,
         biggest: None,
     };
-    let mut solved: std::collections::HashMap<(usize, usize), (Vec<PieceStress>, f64)> =
-        std::collections::HashMap::new();
     let mut begin = 0;
+    let mut cert = Certifier::new(s, params);
     let mut complete = true;
-    // Whether a batch had the last step's programs.
-    let mut last_batched = false;
     let total = bounds.len() as u64;
     for (k, &(step, end)) in bounds.iter().enumerate() {
         if let Some(tell) = tell {
@@ -598,66 +573,45 @@ fn check_steps_in(
             }
             continue;
         }
-        if k >= first_batch && (k - first_batch) % STEPS_A_BATCH == 0 {
-            // The finished model's analysis, if not made yet, starts by
-            // the time it takes before the deadline, so that the two end
-            // near it.
-            let cut = fin.cut(&reserve, deadline, start, true)?;
-            if past(cut) {
-                complete = false;
-                break;
-            }
-            // This batch's programs, all at once. The last step's groups
-            // are the finished model's: made alongside, they take its
-            // answers.
-            window.make_to(k + STEPS_A_BATCH);
-            let batch: Vec<(usize, usize)> = window
-                .ahead()
-                .filter(|&(s, _)| s >= k && s < k + STEPS_A_BATCH)
-                .filter(|&(s, _)| s != last_k || !fin.covers_last())
-                .collect();
-            last_batched |= batch.iter().any(|&(s, _)| s == last_k);
-            let batch_jobs: Vec<&Job> = batch.iter().map(|&(k, j)| window.job(k, j)).collect();
-            // A program that would start past the deadline is left out:
-            // its step stops the check below (a batch of big programs
-            // started just before the deadline would overrun it by
-            // minutes).
-            let results = run_within(s, &batch_jobs, params, cut)?;
-            for ((key, r), job) in batch.into_iter().zip(results).zip(&batch_jobs) {
-                if let Some((r, found, secs)) = r {
-                    reserve.note(job.pieces.len(), found, secs);
-                    solves += usize::from(found == Found::Solved);
-                    certified += usize::from(found == Found::Certified);
-                    solved.insert(key, (r, secs));
-                }
-            }
+        // The finished model's analysis, if not made yet, starts by the
+        // time it takes before the deadline, so that the two end near it.
+        if past(fin.cut(&reserve, deadline, start, true)?) {
+            complete = false;
+            break;
         }
         window.make_to(k + 1);
         let jobs = window.take(k);
         step_seconds = 0.0;
         let mut late = Vec::new();
-        for (j, job) in jobs.iter().enumerate() {
+        for job in &jobs {
             let stood = job
                 .pieces
                 .iter()
                 .all(|&p| p >= begin || !current[p].fails());
-            if let Some((r, secs)) = solved.remove(&(k, j)) {
-                step_seconds = step_seconds.max(secs);
-                for (&p, st) in job.pieces.iter().zip(r) {
-                    current[p] = st;
-                    exact[p] = true;
-                }
-            } else if job.grounded && stood && drops(s, job, begin, end) {
+            if job.grounded && stood && drops(s, job, begin, end) {
                 for &p in job.pieces.iter().filter(|&&p| p >= begin) {
                     current[p] = PieceStress::resting();
+                    cert.drop_straight(p, end);
                 }
                 // It stands, but its answer need not be the program's.
                 for &p in &job.pieces {
                     exact[p] = false;
                 }
                 reused += 1;
-            } else {
+            } else if !job.grounded || k == last_k && fin.covers_last() {
                 late.push(job);
+            } else {
+                match cert.certify(job, begin, end) {
+                    Verdict::Stands(stress) => {
+                        for (&p, st) in job.pieces.iter().zip(stress) {
+                            current[p] = st;
+                            exact[p] = false;
+                        }
+                        certified += 1;
+                    }
+                    // The program's answer says which pieces fail.
+                    Verdict::Fails | Verdict::Unknown => late.push(job),
+                }
             }
         }
         if k == last_k && fin.covers_last() {
@@ -676,7 +630,7 @@ fn check_steps_in(
         }
         // Not started once the last step's programs are solved or about
         // to be: it would solve them again.
-        let due = k != last_k && !last_batched;
+        let due = k != last_k;
         if !late.is_empty() && past(fin.cut(&reserve, deadline, start, due)?) {
             complete = false;
             break;

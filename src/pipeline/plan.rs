@@ -130,8 +130,10 @@ impl<'a> Planner<'a> {
     /// [`Self::plan`]; `told`: the layout's progress is shown. A layout
     /// that fails verification is never handed on: the layout is made
     /// again with other seeds ([`RELAYOUTS`] at most), and the notes say
-    /// so; if none verifies, the first failure is the error (a bug).
+    /// so; if none verifies, the first failure is the error (a bug). No
+    /// layout is begun again once the search's time budget is spent.
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
+        let started = Instant::now();
         let mut first_failure = None;
         // The slopes capping the stairs are the one late change to the
         // layout: a build they leave unverified is laid without them too.
@@ -142,6 +144,9 @@ impl<'a> Planner<'a> {
         };
         for k in 0..=RELAYOUTS {
             for &cap in caps {
+                if first_failure.is_some() && started.elapsed() >= self.opts.search.time_budget {
+                    break;
+                }
                 let s = seed.wrapping_add(k * RELAYOUT_STRIDE);
                 let (outcome, assembly) = self.layout(s, told && k == 0 && cap, cap)?;
                 let t = Instant::now();

@@ -47,12 +47,12 @@ const ESCAPE_LIMIT: usize = 2_048;
 const HOLD_LIMIT: usize = 4_096;
 
 /// Reorders `order` (a derivation of the pieces of `l`) so that every piece
-/// can be put in place at its turn; returns the new order and the positions
-/// in it of the pieces that still cannot (taken out by force).
-pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<usize>) {
+/// can be put in place at its turn (those that still cannot were taken out
+/// by force: the verifier names them).
+pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> Vec<Removal> {
     let n = order.len();
     if n < 2 {
-        return (order, Vec::new());
+        return order;
     }
     let u = l.layer_ldu;
     let boxes: Vec<CellBox> = order.iter().map(|r| r.piece.body(u).bbox).collect();
@@ -61,7 +61,7 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
         .map(|r| l.owner_of(r.piece.body(u).key()))
         .collect::<Option<Vec<u32>>>()
     else {
-        return (order, Vec::new());
+        return order;
     };
     let mut pos_of = vec![u32::MAX; l.pieces.len()];
     for (k, &id) in ids.iter().enumerate() {
@@ -139,7 +139,6 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
         opened_cavity: false,
     };
     let mut taken_out: Vec<usize> = Vec::with_capacity(units.len());
-    let mut forced: Vec<usize> = Vec::new();
     // Units not yet tried (latest last), and units waiting, latest first.
     let mut fresh: Vec<usize> = (0..units.len()).collect();
 
@@ -187,7 +186,6 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
                 state.opened_cavity |= opened.len() > boxes[k].cells().count();
                 state.anchors[k] = best_anchor(&holds[k], &state.present);
             }
-            forced.push(w);
             w
         };
         taken_out.push(unit);
@@ -208,11 +206,7 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
 
     // Forward: the units in the reverse of the order they were taken out.
     let mut out: Vec<Removal> = Vec::with_capacity(n);
-    let mut forced_at: Vec<usize> = Vec::new();
     for &w in taken_out.iter().rev() {
-        if forced.contains(&w) {
-            forced_at.push(out.len());
-        }
         for &k in &units[w] {
             let mut r = order[k];
             if units[w].len() == 1 {
@@ -231,7 +225,7 @@ pub(crate) fn sequence(l: &Layout, order: Vec<Removal>) -> (Vec<Removal>, Vec<us
             out.push(r);
         }
     }
-    (out, forced_at)
+    out
 }
 
 /// Why a unit could not go yet: what must change before it can. Each is
@@ -308,16 +302,18 @@ impl State {
                         && !hold.reaches_start(q, g.holds, g.starts, present, g.z)
                 })
             };
-            // The cheap tests first: the search down to a start may
-            // visit thousands of pieces.
+            // The cheap tests first: the way out (straight ways tried
+            // first) before the search down to a start, which may visit
+            // thousands of pieces.
             let leaves = if !joined {
                 Err(Watch::Never)
-            } else if !self.space.joins_outside(&g.boxes[k]) {
-                Err(Watch::Cavity)
-            } else if let Some(q) = dropped() {
-                Err(Watch::Piece(q))
             } else {
-                self.space.can_leave(&g.boxes[k])
+                self.space
+                    .can_leave(&g.boxes[k])
+                    .and_then(|()| match dropped() {
+                        Some(q) => Err(Watch::Piece(q)),
+                        None => Ok(()),
+                    })
             };
             if let Err(w) = leaves {
                 self.present[k] = true;

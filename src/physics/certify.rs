@@ -1,0 +1,575 @@
+//! Step certificates: an equilibrium of the pieces placed so far, kept
+//! from step to step.
+//!
+//! A step **stands** when its pieces have an equilibrium under gravity
+//! with no hand force and every stud joint within its capacity (the safe
+//! theorem of rigid-block analysis: if the contacts can carry the loads
+//! in some way, the structure stands). Any method may find one; what says
+//! "stands" is a check of the one found against every equation and bound.
+//!
+//! The check keeps the equilibrium found for the step before. A step adds
+//! pieces; their weight must be carried, and only the forces near them
+//! need change: the change is looked for among the new pieces and a few
+//! rings of contacts around them (the pieces in reach, the contacts among
+//! them and their grounds), as a small linear program whose unknowns are
+//! the changes to those forces, bounded so that the new forces stay
+//! within their own bounds (compression pushes, tension pulls at most a
+//! stud's capacity), with every other force held as it was. The rings
+//! widen while no change is found, up to the whole group: there the
+//! program is exact (every force of the group may change), and no change
+//! found means no equilibrium exists: the step fails. A change found is
+//! added and checked, piece by piece over the whole group, before the
+//! step is said to stand.
+//!
+//! A piece whose weight drops straight down to the ground in compression
+//! (see [`Structure::drops_straight`]) needs no program: its weight is
+//! added, as pushes at the same point, to every face on the way down.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use super::groups::Job;
+use super::model::{Rect, Structure};
+use super::{Params, PieceStress};
+
+/// The most a stud carries in a certificate: just under its capacity
+/// (a usage of 1 breaks the joint).
+const CAP: f64 = 1.0 - 1e-6;
+
+/// Rings of contacts around the new pieces tried before the whole group.
+const RINGS: [usize; 4] = [0, 1, 2, 4];
+
+/// A ring holding this share of the group is the whole group.
+const WHOLE_SHARE: f64 = 0.5;
+
+/// Cost of a unit of compression, against 1 for a unit of tension: the
+/// change found pushes rather than pulls, keeping clutch for later steps.
+const PUSH_COST: f64 = 1e-3;
+
+/// What the certificate says of a group after a step.
+pub(super) enum Verdict {
+    /// It stands: each piece's stress in the equilibrium found, in the
+    /// group's order.
+    Stands(Vec<PieceStress>),
+    /// No equilibrium exists (the exact program has none).
+    Fails,
+    /// The solver gave no answer.
+    Unknown,
+}
+
+/// The forces of the pieces placed so far (see the module docs).
+pub(super) struct Certifier<'a> {
+    s: &'a Structure,
+    /// A piece's equations hold within this share of its weight.
+    tol: f64,
+    /// Per contact, its first force (a face's four corners, then its
+    /// studs); per piece, its first ground force at `goff` (the corners of
+    /// its bottom on the ground, then its tubes on a baseplate).
+    coff: Vec<usize>,
+    goff: Vec<usize>,
+    f: Vec<f64>,
+    /// Per piece, its contacts.
+    touching: Vec<Vec<usize>>,
+    /// Scratch: per piece, its place in the region (`u32::MAX`: none).
+    local: Vec<u32>,
+    /// Certificates found, per ring (the last: the whole group).
+    pub found: [usize; RINGS.len() + 1],
+    /// Pieces in the regions of the certificates found, summed.
+    pub region_pieces: usize,
+}
+
+/// One unknown of a region's program: which force, where, and how it acts.
+#[derive(Debug, Clone, Copy)]
+struct Var {
+    /// Index into the forces.
+    at: usize,
+    /// Where it acts.
+    point: (f64, f64),
+    /// The piece it pushes up (pulls down, for a tension) and the piece it
+    /// pushes down (pulls up), if any.
+    up: usize,
+    down: Option<usize>,
+    tension: bool,
+}
+
+impl<'a> Certifier<'a> {
+    pub(super) fn new(s: &'a Structure, params: &Params) -> Certifier<'a> {
+        let n = s.loads.len();
+        let mut coff = Vec::with_capacity(s.contacts.len());
+        let mut next = 0;
+        let mut touching = vec![Vec::new(); n];
+        for (k, c) in s.contacts.iter().enumerate() {
+            coff.push(next);
+            next += if c.face.is_some() { 4 } else { 0 } + c.studs.len();
+            touching[c.below].push(k);
+            touching[c.above].push(k);
+        }
+        let mut goff = Vec::with_capacity(n);
+        for l in &s.loads {
+            goff.push(next);
+            next += if l.ground.is_some() { 4 } else { 0 } + l.ground_studs.len();
+        }
+        Certifier {
+            s,
+            tol: params.fall_tolerance,
+            coff,
+            goff,
+            f: vec![0.0; next],
+            touching,
+            local: vec![u32::MAX; n],
+            found: [0; RINGS.len() + 1],
+            region_pieces: 0,
+        }
+    }
+
+    /// The forces of contact `k`, or of piece `p`'s ground, with the piece
+    /// pushed up first.
+    fn contact_vars(&self, k: usize, out: &mut Vec<Var>) {
+        let c = &self.s.contacts[k];
+        let mut at = self.coff[k];
+        if let Some(face) = c.face {
+            for point in face.corners() {
+                out.push(Var {
+                    at,
+                    point,
+                    up: c.above,
+                    down: Some(c.below),
+                    tension: false,
+                });
+                at += 1;
+            }
+        }
+        for &point in &c.studs {
+            out.push(Var {
+                at,
+                point,
+                up: c.above,
+                down: Some(c.below),
+                tension: true,
+            });
+            at += 1;
+        }
+    }
+
+    fn ground_vars(&self, p: usize, out: &mut Vec<Var>) {
+        let l = &self.s.loads[p];
+        let mut at = self.goff[p];
+        if let Some(g) = l.ground {
+            for point in g.corners() {
+                out.push(Var {
+                    at,
+                    point,
+                    up: p,
+                    down: None,
+                    tension: false,
+                });
+                at += 1;
+            }
+        }
+        for &point in &l.ground_studs {
+            out.push(Var {
+                at,
+                point,
+                up: p,
+                down: None,
+                tension: true,
+            });
+            at += 1;
+        }
+    }
+
+    /// Piece `p`'s equations: its weight less the forces on it (vertical,
+    /// then the moments about its centre of mass), counting contacts with
+    /// pieces before `end` only.
+    fn residual(&self, p: usize, end: usize, vars: &mut Vec<Var>) -> [f64; 3] {
+        let l = &self.s.loads[p];
+        let mut r = [l.weight, 0.0, 0.0];
+        vars.clear();
+        for &k in &self.touching[p] {
+            let c = &self.s.contacts[k];
+            if c.below.max(c.above) < end {
+                self.contact_vars(k, vars);
+            }
+        }
+        self.ground_vars(p, vars);
+        for v in vars.iter() {
+            let f = self.f[v.at] * sign(v, p);
+            r[0] -= f;
+            r[1] -= f * (v.point.0 - l.com.0);
+            r[2] -= f * (v.point.1 - l.com.1);
+        }
+        r
+    }
+
+    /// Whether piece `p`'s equations hold (within [`Params::fall_tolerance`]
+    /// of its weight, a moment within that force at its far edge).
+    fn balanced(&self, p: usize, end: usize, vars: &mut Vec<Var>) -> bool {
+        let l = &self.s.loads[p];
+        let r = self.residual(p, end, vars);
+        let e = &l.extent;
+        let reach = (e.x1 - e.x0).max(e.y1 - e.y0).max(1.0);
+        let t = self.tol * l.weight;
+        r[0].abs() <= t && r[1].abs() <= t * reach && r[2].abs() <= t * reach
+    }
+
+    /// Adds piece `p`'s weight straight down to the ground, as pushes at
+    /// its centre of mass on every face on the way (the pieces before
+    /// `end`); false, changing nothing, if the way is not straight (see
+    /// [`Structure::drops_straight`]).
+    pub(super) fn drop_straight(&mut self, p: usize, end: usize) -> bool {
+        if !self.s.drops_straight(p, end) {
+            return false;
+        }
+        let s = self.s;
+        let (w, (x, y)) = (s.loads[p].weight, s.loads[p].com);
+        let inside = |r: &Rect| {
+            const EPS: f64 = 1e-9;
+            r.x0 - EPS <= x && x <= r.x1 + EPS && r.y0 - EPS <= y && y <= r.y1 + EPS
+        };
+        let mut q = p;
+        loop {
+            if let Some(g) = s.loads[q].ground.filter(inside) {
+                self.push(self.goff[q], &g, (x, y), w);
+                return true;
+            }
+            let next = s.under[q]
+                .iter()
+                .copied()
+                .find(|&k| {
+                    let c = &s.contacts[k];
+                    c.below < end && c.face.as_ref().is_some_and(inside)
+                })
+                .expect("drops_straight found the way");
+            let c = &s.contacts[next];
+            self.push(self.coff[next], &c.face.expect("a face"), (x, y), w);
+            q = c.below;
+        }
+    }
+
+    /// Adds a push `w` at `point` in rectangle `r` to its corner forces
+    /// from `at` (bilinear weights).
+    fn push(&mut self, at: usize, r: &Rect, point: (f64, f64), w: f64) {
+        let u = ((point.0 - r.x0) / (r.x1 - r.x0)).clamp(0.0, 1.0);
+        let v = ((point.1 - r.y0) / (r.y1 - r.y0)).clamp(0.0, 1.0);
+        for (i, share) in [(1.0 - u) * (1.0 - v), u * (1.0 - v), (1.0 - u) * v, u * v]
+            .into_iter()
+            .enumerate()
+        {
+            self.f[at + i] += w * share;
+        }
+    }
+
+    /// The verdict on group `job` after a step placed the pieces before
+    /// `end`, those from `begin` new: the kept forces changed near the new
+    /// pieces (see the module docs).
+    pub(super) fn certify(&mut self, job: &Job, begin: usize, end: usize) -> Verdict {
+        let mut vars = Vec::new();
+        // The kept forces must hold the old pieces already; if not (the
+        // group failed before), only the whole group can mend them.
+        let kept = job
+            .pieces
+            .iter()
+            .all(|&p| p >= begin || self.balanced(p, end, &mut vars));
+        let mut new: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
+        // The new weight leaves the region only through its grounds: the
+        // region holds a way down to the ground from each new piece.
+        for i in 0..new.len() {
+            let way = self.way_down(&[new[i]], end);
+            new.extend(way);
+        }
+        let whole_at = (WHOLE_SHARE * job.pieces.len() as f64) as usize;
+        let mut tried = 0;
+        for (i, &rings) in RINGS.iter().enumerate() {
+            if !kept {
+                break;
+            }
+            let region = self.region(&new, rings, end);
+            if region.len() >= whole_at || region.len() <= tried {
+                break;
+            }
+            tried = region.len();
+            let r = self.try_region(&region, job, end);
+            if let Some(Some(stress)) = r {
+                self.found[i] += 1;
+                self.region_pieces += region.len();
+                return Verdict::Stands(stress);
+            }
+        }
+        let r = self.try_region(&job.pieces, job, end);
+        match r {
+            Some(Some(stress)) => {
+                self.found[RINGS.len()] += 1;
+                self.region_pieces += job.pieces.len();
+                Verdict::Stands(stress)
+            }
+            Some(None) => Verdict::Fails,
+            None => Verdict::Unknown,
+        }
+    }
+
+    /// The pieces on a way through contacts from the pieces `from` down to
+    /// a piece on the ground (before `end`), lowest first at each turn;
+    /// empty if none.
+    fn way_down(&mut self, from: &[usize], end: usize) -> Vec<usize> {
+        use std::cmp::Reverse;
+        let s = self.s;
+        let mut heap = std::collections::BinaryHeap::new();
+        let mut seen: Vec<usize> = Vec::new();
+        for &p in from {
+            self.local[p] = p as u32;
+            seen.push(p);
+            heap.push(Reverse((s.loads[p].z, p)));
+        }
+        let mut reached = None;
+        while let Some(Reverse((_, p))) = heap.pop() {
+            if s.loads[p].ground.is_some() || !s.loads[p].ground_studs.is_empty() {
+                reached = Some(p);
+                break;
+            }
+            for &k in &self.touching[p] {
+                let c = &s.contacts[k];
+                if c.below.max(c.above) >= end {
+                    continue;
+                }
+                let q = if c.below == p { c.above } else { c.below };
+                if self.local[q] == u32::MAX {
+                    self.local[q] = p as u32;
+                    seen.push(q);
+                    heap.push(Reverse((s.loads[q].z, q)));
+                }
+            }
+        }
+        let mut way = Vec::new();
+        let mut q = reached;
+        while let Some(p) = q {
+            way.push(p);
+            let from = self.local[p] as usize;
+            q = (from != p).then_some(from);
+        }
+        for p in seen {
+            self.local[p] = u32::MAX;
+        }
+        way
+    }
+
+    /// The pieces before `end` within `rings` contacts of `from`, sorted.
+    fn region(&mut self, from: &[usize], rings: usize, end: usize) -> Vec<usize> {
+        let mut region: Vec<usize> = Vec::with_capacity(from.len());
+        for &p in from {
+            if self.local[p] == u32::MAX {
+                self.local[p] = 0;
+                region.push(p);
+            }
+        }
+        let mut frontier = 0;
+        for _ in 0..rings {
+            let stop = region.len();
+            for i in frontier..stop {
+                for &k in &self.touching[region[i]] {
+                    let c = &self.s.contacts[k];
+                    if c.below.max(c.above) >= end {
+                        continue;
+                    }
+                    for q in [c.below, c.above] {
+                        if self.local[q] == u32::MAX {
+                            self.local[q] = 0;
+                            region.push(q);
+                        }
+                    }
+                }
+            }
+            frontier = stop;
+        }
+        for &p in &region {
+            self.local[p] = u32::MAX;
+        }
+        region.sort_unstable();
+        region
+    }
+
+    /// Looks for a change to the forces among `region` (sorted pieces of
+    /// `job`) that balances them; adds it and checks the group. `Some(Some)`
+    /// with the group's stress if found and checked, `Some(None)` if the
+    /// program has no answer (none exists in this region), `None` if the
+    /// solver failed or the check did not pass.
+    fn try_region(
+        &mut self,
+        region: &[usize],
+        job: &Job,
+        end: usize,
+    ) -> Option<Option<Vec<PieceStress>>> {
+        for (i, &p) in region.iter().enumerate() {
+            self.local[p] = i as u32;
+        }
+        let found = self.solve_region(region, end);
+        for &p in region {
+            self.local[p] = u32::MAX;
+        }
+        let (vars, change) = match found {
+            Found::Change(vars, change) => (vars, change),
+            Found::None => return Some(None),
+            Found::Trouble => return None,
+        };
+        let before: Vec<f64> = vars.iter().map(|v| self.f[v.at]).collect();
+        for (v, d) in vars.iter().zip(&change) {
+            let f = &mut self.f[v.at];
+            *f = (*f + d).max(0.0);
+            if v.tension {
+                *f = f.min(CAP);
+            }
+        }
+        let mut scratch = Vec::new();
+        if !job
+            .pieces
+            .iter()
+            .all(|&p| self.balanced(p, end, &mut scratch))
+        {
+            for (v, f) in vars.iter().zip(before) {
+                self.f[v.at] = f;
+            }
+            return None;
+        }
+        Some(Some(self.stress(job, end)))
+    }
+
+    /// The stress of every piece of `job` in the kept forces: its usage is
+    /// its most loaded stud's tension.
+    fn stress(&self, job: &Job, end: usize) -> Vec<PieceStress> {
+        let mut vars = Vec::new();
+        job.pieces
+            .iter()
+            .map(|&p| {
+                vars.clear();
+                for &k in &self.touching[p] {
+                    let c = &self.s.contacts[k];
+                    if c.below.max(c.above) < end {
+                        self.contact_vars(k, &mut vars);
+                    }
+                }
+                self.ground_vars(p, &mut vars);
+                let usage = vars
+                    .iter()
+                    .filter(|v| v.tension)
+                    .map(|v| self.f[v.at])
+                    .fold(0.0, f64::max);
+                let mut st = PieceStress {
+                    usage,
+                    score: 1.0,
+                    falls: false,
+                    breaks: false,
+                };
+                st.finish();
+                st
+            })
+            .collect()
+    }
+
+    /// The program of a region (its pieces numbered in `self.local`): the
+    /// changes to the forces among its pieces and their grounds that
+    /// balance every piece of it, each force kept within its bounds.
+    fn solve_region(&self, region: &[usize], end: usize) -> Found {
+        let inside = |p: usize| self.local[p] != u32::MAX;
+        let mut vars = Vec::new();
+        for &p in region {
+            for &k in &self.touching[p] {
+                let c = &self.s.contacts[k];
+                // Each contact once, from its upper piece.
+                if c.above == p && c.below.max(c.above) < end && inside(c.below) {
+                    self.contact_vars(k, &mut vars);
+                }
+            }
+            self.ground_vars(p, &mut vars);
+        }
+        let eq = 3 * region.len();
+        let nv = vars.len();
+        let tensions = vars.iter().filter(|v| v.tension).count();
+        let rows = eq + nv + tensions;
+        let mut b = vec![0.0; rows];
+        let mut scratch = Vec::new();
+        for (i, &p) in region.iter().enumerate() {
+            b[3 * i..3 * i + 3].copy_from_slice(&self.residual(p, end, &mut scratch));
+        }
+        let (mut colptr, mut rowval, mut nzval) = (vec![0], Vec::new(), Vec::new());
+        let mut cost = Vec::with_capacity(nv);
+        let mut next_cap = eq + nv;
+        for (j, v) in vars.iter().enumerate() {
+            let mut acting = vec![v.up];
+            acting.extend(v.down);
+            acting.sort_by_key(|&p| self.local[p]);
+            for p in acting {
+                let i = self.local[p] as usize;
+                let com = self.s.loads[p].com;
+                let f = sign(v, p);
+                for (r, x) in [
+                    (3 * i, f),
+                    (3 * i + 1, f * (v.point.0 - com.0)),
+                    (3 * i + 2, f * (v.point.1 - com.1)),
+                ] {
+                    rowval.push(r);
+                    nzval.push(x);
+                }
+            }
+            // The new force stays at or above 0: -d <= f.
+            rowval.push(eq + j);
+            nzval.push(-1.0);
+            b[eq + j] = self.f[v.at];
+            if v.tension {
+                // And a tension at or below a stud's capacity.
+                rowval.push(next_cap);
+                nzval.push(1.0);
+                b[next_cap] = CAP - self.f[v.at];
+                next_cap += 1;
+            }
+            colptr.push(rowval.len());
+            cost.push(if v.tension { 1.0 } else { PUSH_COST });
+        }
+        let a = CscMatrix::new(rows, nv, colptr, rowval, nzval);
+        let pm = CscMatrix::zeros((nv, nv));
+        let cones = [
+            SupportedConeT::ZeroConeT(eq),
+            SupportedConeT::NonnegativeConeT(nv + tensions),
+        ];
+        let Ok(settings) = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_threads(1)
+            .direct_solve_method("qdldl".to_string())
+            .iterative_refinement_enable(false)
+            .build()
+        else {
+            return Found::Trouble;
+        };
+        let Ok(mut solver) = DefaultSolver::new(&pm, &cost, &a, &b, &cones, settings) else {
+            return Found::Trouble;
+        };
+        solver.solve();
+        match solver.solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {
+                Found::Change(vars, solver.solution.x.clone())
+            }
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Found::None,
+            _ => Found::Trouble,
+        }
+    }
+}
+
+/// What a region's program found.
+enum Found {
+    /// A change to these forces.
+    Change(Vec<Var>, Vec<f64>),
+    /// None exists.
+    None,
+    /// The solver gave no answer.
+    Trouble,
+}
+
+/// +1 if force `v` pushes piece `p` up, -1 if down.
+fn sign(v: &Var, p: usize) -> f64 {
+    let up = if v.up == p { 1.0 } else { -1.0 };
+    if v.tension {
+        -up
+    } else {
+        up
+    }
+}
