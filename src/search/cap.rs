@@ -30,7 +30,9 @@
 //! slanting the way the mesh does, one colour). A swap that does not fit
 //! every part is undone. The swaps together add at most one piece in
 //! `BUDGET_SHARE` of the layout's (and one swap at most `MAX_ADDED`),
-//! so that the build keeps its voxels a piece within about a tenth; after
+//! so that the build keeps its voxels a piece within about a tenth; the
+//! swaps that add one piece at most go first, all over the build, then
+//! those that add two, so that the budget caps the most edges; after
 //! them, neighbouring bricks merge into longer ones and neighbouring
 //! slopes facing the same way into wider ones (two 2x2 slopes into a
 //! 2x4), each merge undone with the swaps if they are.
@@ -96,7 +98,7 @@ const JOIN_WALK: usize = 400;
 /// The pieces the swaps may add to the build, at most: one in this many
 /// of the layout's pieces (the build keeps its voxels a piece within about
 /// a tenth).
-const BUDGET_SHARE: usize = 8;
+const BUDGET_SHARE: usize = 9;
 
 /// The pieces one swap may add (slopes and bricks laid, less the brick
 /// taken out).
@@ -149,10 +151,14 @@ impl Layout<'_> {
         // Roofs from the eaves up: a slope's front row may lie on the back
         // row of the slope capped just below it. Underneath, from the top
         // down.
-        for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
+        // The cheap swaps first: one piece added at most, then two.
+        let passes =
+            (1..=MAX_ADDED).flat_map(|k| [(Shape::Slope, top, k), (Shape::Inverted, under, k)]);
+        for (kind, wanted, per_swap) in passes {
             if !wanted {
                 continue;
             }
+            budget.per_swap = per_swap;
             let mut order = bricks.clone();
             order.sort_by_key(|&id| {
                 let z = self.pieces[id as usize].body.bbox.min.z;
