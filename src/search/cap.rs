@@ -59,8 +59,12 @@ pub(crate) struct Swap {
     pub slopes: usize,
 }
 
+/// A piece about to be laid: where, and the cells it fills.
+type Part = (Placement, Body);
+
 /// What is left of brick box `b` when its `rows` rows along its side
-/// facing `d` become slopes; `None` if the brick is not `rows` deep.
+/// facing `d` become slopes: `Some(None)` when nothing is, `None` if the
+/// brick is not `rows` deep.
 fn rest_box(b: &CellBox, d: (i32, i32), rows: i32) -> Option<Option<CellBox>> {
     let depth = if d.0 != 0 { b.sx } else { b.sy };
     if depth < rows {
@@ -442,7 +446,7 @@ impl Layout<'_> {
         // 45° slopes (their back row on the side row) and 33° ones (their
         // back two rows in the brick): the plan that adds the fewest pieces
         // first, then the 45° one.
-        let mut plans: Vec<(usize, i32, Vec<(Placement, Body)>, usize)> = [2, 3]
+        let mut plans: Vec<(usize, i32, Vec<Part>, usize)> = [2, 3]
             .into_iter()
             .filter_map(|deep| {
                 let (slopes, rest) = self.plan_swap(&b, d, kind, &side, deep)?;
@@ -507,7 +511,7 @@ impl Layout<'_> {
         kind: Shape,
         side: &[Cell],
         deep: i32,
-    ) -> Option<(Vec<(Placement, Body)>, Vec<(Placement, Body)>)> {
+    ) -> Option<(Vec<Part>, Vec<Part>)> {
         let rest = match rest_box(b, d, deep - 1)? {
             Some(r) => self.bricks_for(&r)?,
             None => Vec::new(),
@@ -519,7 +523,7 @@ impl Layout<'_> {
         let mut at = 0;
         while at < width {
             let left = width - at;
-            let (w, placed) = self.slope_for(side[at as usize], step, left, d, kind, b, deep)?;
+            let (w, placed) = self.slope_for(side[at as usize], step, left, d, kind, deep)?;
             slopes.push(placed);
             at += w;
         }
@@ -713,10 +717,10 @@ impl Layout<'_> {
         })
     }
 
-    /// The widest 45° slope of `kind` (two rows deep) of the alphabet, at
-    /// most `left` studs wide, whose back row starts at `start` and runs
-    /// `step`-wise, facing `d`, in the layers of `b`; its width and
-    /// placement.
+    /// The widest slope of `kind`, `deep` rows deep, of the alphabet, at
+    /// most `left` studs wide, whose row behind the front row starts at
+    /// `start` (its bottom layer) and runs `step`-wise, facing `d`; its
+    /// width and placement.
     fn slope_for(
         &self,
         start: Cell,
@@ -724,9 +728,8 @@ impl Layout<'_> {
         left: i32,
         d: (i32, i32),
         kind: Shape,
-        b: &CellBox,
         deep: i32,
-    ) -> Option<(i32, (Placement, Body))> {
+    ) -> Option<(i32, Part)> {
         let mut best: Option<(i32, PartKind, Rot)> = None;
         for s in &self.shapes {
             let spec = s.part.spec();
@@ -743,7 +746,7 @@ impl Layout<'_> {
         // The slope's box: its front row one stud beyond the side, the row
         // behind it along the side, any other rows further into the brick.
         let end = start.offset(step.0 * (w - 1), step.1 * (w - 1), 0);
-        let back = (deep - 2) * -1;
+        let back = -(deep - 2);
         let corners = [
             start.offset(d.0, d.1, 0),
             end.offset(d.0, d.1, 0),
@@ -753,9 +756,50 @@ impl Layout<'_> {
         let min = Cell::new(
             corners.iter().map(|c| c.x).min().unwrap_or(start.x),
             corners.iter().map(|c| c.y).min().unwrap_or(start.y),
-            b.min.z,
+            start.z,
         );
         let body = part.body(rot, min, self.layer_ldu);
         Some((w, (Placement::new(part, min, rot), body)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn brick(sx: i32, sy: i32) -> CellBox {
+        CellBox {
+            min: Cell::new(10, 20, 4),
+            sx,
+            sy,
+            sz: 2,
+        }
+    }
+
+    #[test]
+    fn the_rest_of_a_brick_is_the_rows_behind_the_side() {
+        // A 2x8 brick along x capped at its +x end by a 45° slope (one row
+        // in the brick): 7x2 left, at the brick's corner.
+        let b = brick(8, 2);
+        assert_eq!(rest_box(&b, (1, 0), 1), Some(Some(CellBox { sx: 7, ..b })));
+        // At its -x end by a 33° slope (two rows): 6x2 left, two studs in.
+        let r = CellBox {
+            min: Cell::new(12, 20, 4),
+            sx: 6,
+            ..b
+        };
+        assert_eq!(rest_box(&b, (-1, 0), 2), Some(Some(r)));
+        // Along its long side: one row left; both rows: none; three: the
+        // brick is too shallow.
+        assert_eq!(
+            rest_box(&b, (0, -1), 1),
+            Some(Some(CellBox {
+                min: Cell::new(10, 21, 4),
+                sy: 1,
+                ..b
+            }))
+        );
+        assert_eq!(rest_box(&b, (0, 1), 2), Some(None));
+        assert_eq!(rest_box(&b, (0, 1), 3), None);
     }
 }
