@@ -11,14 +11,31 @@
 //! at the bottom of the build (nothing under it) hanging two layers below
 //! its neighbours becomes inverted slopes the same way.
 //!
-//! A swap keeps every joint: the slopes (and what is left of the brick, a
-//! shorter brick) each rest on, or hold, a piece the rules join them to,
-//! and the slopes must fit where the layout's own candidates must (their
-//! cells free, inside the model or where the surface passes, the open face
-//! clear and slanting the way the mesh does, one colour). A swap that does
-//! not fit every part is undone. Brick count grows by at most one a swap
-//! (the shorter brick), and only where the brick was more than one stud
-//! deep.
+//! The slopes are 45° ones (two rows deep: the back row takes the brick's
+//! side row) or 33° ones (three rows deep: the back two take the brick's
+//! two rows along the side), whichever leaves the fewest pieces: a 2x8
+//! brick capped at its short end becomes a 33° 2x3 slope and a 2x6 brick
+//! rather than a 45° 2x2 slope, a 2x4 and a 2x3. What is left of the brick
+//! is laid as few bricks of the alphabet as fill it (no 1x1s), and those
+//! are capped again where they stand a step above their neighbours too (a
+//! ridge brick gets slopes on both sides). Roofs are capped from the eaves
+//! up, so that a slope's front row lies on the back row of the slope
+//! capped just below it.
+//!
+//! A swap keeps the build whole: the slopes and bricks laid each rest on,
+//! or hold, a piece the rules join them to, the pieces the brick joined
+//! still meet through them (a short walk over the joints), and the slopes
+//! fit where the layout's own candidates must (their cells free, inside
+//! the model or where the surface passes, the open face clear and
+//! slanting the way the mesh does, one colour). A swap that does not fit
+//! every part is undone. The swaps together add at most one piece in
+//! `BUDGET_SHARE` of the layout's (and one swap at most `MAX_ADDED`),
+//! so that the build keeps its voxels a piece within about a tenth; the
+//! swaps that add one piece at most go first, all over the build, then
+//! those that add two, so that the budget caps the most edges; after
+//! them, neighbouring bricks merge into longer ones and neighbouring
+//! slopes facing the same way into wider ones (two 2x2 slopes into a
+//! 2x4), each merge undone with the swaps if they are.
 
 use super::layout::{Layout, Reach};
 use crate::assembly::Placement;
@@ -33,13 +50,78 @@ const SLANT_DEPTH: i32 = 2;
 /// One brick swapped for slopes (and a shorter brick).
 #[derive(Debug, Clone)]
 pub(crate) struct Swap {
-    /// The brick taken out.
-    brick: u32,
+    /// The pieces taken out: the brick (two pieces for a merge after the
+    /// swaps).
+    taken: Vec<u32>,
     /// The pieces laid in its place.
     laid: std::ops::Range<u32>,
     /// How many of them are slopes.
     pub slopes: usize,
 }
+
+/// A piece about to be laid: where, and the cells it fills.
+type Part = (Placement, Body);
+
+/// What is left of brick box `b` when its `rows` rows along its side
+/// facing `d` become slopes: `Some(None)` when nothing is, `None` if the
+/// brick is not `rows` deep.
+fn rest_box(b: &CellBox, d: (i32, i32), rows: i32) -> Option<Option<CellBox>> {
+    let depth = if d.0 != 0 { b.sx } else { b.sy };
+    if depth < rows {
+        return None;
+    }
+    if depth == rows {
+        return Some(None);
+    }
+    Some(Some(match d {
+        (1, 0) => CellBox {
+            sx: b.sx - rows,
+            ..*b
+        },
+        (-1, 0) => CellBox {
+            min: b.min.offset(rows, 0, 0),
+            sx: b.sx - rows,
+            ..*b
+        },
+        (0, 1) => CellBox {
+            sy: b.sy - rows,
+            ..*b
+        },
+        _ => CellBox {
+            min: b.min.offset(0, rows, 0),
+            sy: b.sy - rows,
+            ..*b
+        },
+    }))
+}
+
+/// How many pieces the walk that checks a swap keeps the build joined
+/// may pass through (see `Layout::still_joined`).
+const JOIN_WALK: usize = 400;
+
+/// The pieces the swaps may add to the build, at most: one in this many
+/// of the layout's pieces (the build keeps its voxels a piece within about
+/// a tenth).
+const BUDGET_SHARE: usize = 9;
+
+/// The pieces one swap may add (slopes and bricks laid, less the brick
+/// taken out).
+const MAX_ADDED: usize = 2;
+
+/// What the swaps may still add.
+#[derive(Debug, Clone, Copy)]
+struct Budget {
+    /// Pieces, over all the swaps.
+    pieces: usize,
+    /// Pieces, in one swap.
+    per_swap: usize,
+}
+
+/// Passes of merging after the swaps.
+const MERGE_ROUNDS: usize = 4;
+
+/// How many times the bricks left of a swap are capped again.
+const MAX_DEPTH: u32 = 2;
 
 /// The four horizontal directions a step can fall.
 const DIRS: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
@@ -65,13 +147,22 @@ impl Layout<'_> {
             })
             .collect();
         let mut laid = 0;
+        let live = self.pieces.iter().filter(|p| !p.gone).count();
+        let mut budget = Budget {
+            pieces: live / BUDGET_SHARE,
+            per_swap: MAX_ADDED,
+        };
         // Roofs from the eaves up: a slope's front row may lie on the back
         // row of the slope capped just below it. Underneath, from the top
         // down.
-        for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
+        // The cheap swaps first: one piece added at most, then two.
+        let passes =
+            (1..=MAX_ADDED).flat_map(|k| [(Shape::Slope, top, k), (Shape::Inverted, under, k)]);
+        for (kind, wanted, per_swap) in passes {
             if !wanted {
                 continue;
             }
+            budget.per_swap = per_swap;
             let mut order = bricks.clone();
             order.sort_by_key(|&id| {
                 let z = self.pieces[id as usize].body.bbox.min.z;
@@ -82,10 +173,10 @@ impl Layout<'_> {
                     continue;
                 }
                 let first = self.pieces.len() as u32;
-                if let Some(k) = self.cap_piece(id, kind) {
+                if let Some(k) = self.cap_piece(id, kind, 0, &mut budget) {
                     laid += k;
                     swaps.push(Swap {
-                        brick: id,
+                        taken: vec![id],
                         laid: first..self.pieces.len() as u32,
                         slopes: k,
                     });
@@ -93,9 +184,113 @@ impl Layout<'_> {
             }
         }
         if laid > 0 {
+            self.merge_after(&mut swaps);
             self.rebuild_bodies();
         }
         swaps
+    }
+
+    /// Merges the bricks the swaps left with their neighbours where the
+    /// union is a brick of the alphabet (see [`Layout::merge`]), each
+    /// merge kept as a swap of its own so that [`Layout::uncap`] undoes it.
+    fn merge_after(&mut self, swaps: &mut Vec<Swap>) {
+        for _ in 0..MERGE_ROUNDS {
+            let mut merged = 0;
+            for a in 0..self.pieces.len() as u32 {
+                if self.pieces[a as usize].gone {
+                    continue;
+                }
+                let first = self.pieces.len() as u32;
+                let merge = self
+                    .merge_with_neighbour(a)
+                    .or_else(|| self.merge_slopes(a));
+                if let Some(b) = merge {
+                    swaps.push(Swap {
+                        taken: vec![a, b],
+                        laid: first..self.pieces.len() as u32,
+                        slopes: 0,
+                    });
+                    merged += 1;
+                }
+            }
+            self.stats.merges += merged;
+            if merged == 0 {
+                break;
+            }
+        }
+    }
+
+    /// Merges slope `a` with the slope past its +x or +y side if they face
+    /// the same way in the same layers and the alphabet has a slope as
+    /// wide as both (two 2x2 slopes become a 2x4): a roof's slopes in rows
+    /// as long as the parts allow. The neighbour merged, if any.
+    fn merge_slopes(&mut self, a: u32) -> Option<u32> {
+        let pa = self.pieces[a as usize];
+        let sa = pa.placement.part.spec();
+        if !matches!(sa.shape, Shape::Slope | Shape::Inverted) || pa.group.is_some() {
+            return None;
+        }
+        let ba = pa.body.bbox;
+        let back = sa.back(pa.placement.rot);
+        // Side by side across the slope's width: along x when it faces y.
+        let (dx, dy) = if back.0 == 0 { (ba.sx, 0) } else { (0, ba.sy) };
+        let b = self.owner_of(ba.min.offset(dx, dy, 0))?;
+        let pb = self.pieces[b as usize];
+        let sb = pb.placement.part.spec();
+        let bb = pb.body.bbox;
+        let aligned = b != a
+            && pb.group.is_none()
+            && sb.shape == sa.shape
+            && sb.studs_y == sa.studs_y
+            && sb.back(pb.placement.rot) == back
+            && bb.min.z == ba.min.z
+            && bb.sz == ba.sz
+            && if dx > 0 {
+                bb.min.y == ba.min.y && bb.sy == ba.sy && bb.min.x == ba.min.x + ba.sx
+            } else {
+                bb.min.x == ba.min.x && bb.sx == ba.sx && bb.min.y == ba.min.y + ba.sy
+            };
+        if !aligned {
+            return None;
+        }
+        let width = (sa.studs_x + sb.studs_x) as i32;
+        let shape = self.shapes.iter().find(|s| {
+            let sp = s.part.spec();
+            sp.shape == sa.shape
+                && sp.studs_y == sa.studs_y
+                && sp.studs_x as i32 == width
+                && sp.back(s.rot) == back
+        })?;
+        let (part, rot) = (shape.part, shape.rot);
+        let placement = Placement::new(part, ba.min, rot);
+        let body = part.body(rot, ba.min, self.layer_ldu);
+        let around: Vec<u32> = self
+            .below(&pa.body)
+            .into_iter()
+            .chain(self.below(&pb.body))
+            .chain(self.above(&pa.body))
+            .chain(self.above(&pb.body))
+            .collect();
+        self.remove(a);
+        self.remove(b);
+        let u = self.layer_ldu;
+        let joins = |l: &Self, o: u32| {
+            let other = &l.pieces[o as usize].placement;
+            l.book.joint(other, &placement, Dir::Up, u).is_some()
+                || l.book.joint(&placement, other, Dir::Down, u).is_some()
+                || l.book.joint(&placement, other, Dir::Up, u).is_some()
+                || l.book.joint(other, &placement, Dir::Down, u).is_some()
+        };
+        let fits = self
+            .fits_within(&placement, &body, Reach::Far, SLANT_DEPTH)
+            .is_some();
+        if fits && around.iter().all(|&o| joins(self, o)) {
+            self.place(placement, body, None);
+            return Some(b);
+        }
+        self.restore(a);
+        self.restore(b);
+        None
     }
 
     /// Undoes `swaps` (the bricks back, the slopes out), last first.
@@ -104,21 +299,31 @@ impl Layout<'_> {
             for id in s.laid.clone() {
                 self.remove(id);
             }
-            self.restore(s.brick);
+            for &id in s.taken.iter().rev() {
+                self.restore(id);
+            }
         }
         if !swaps.is_empty() {
             self.rebuild_bodies();
         }
     }
 
-    /// Swaps the row of piece `id` along its side that falls most for
-    /// slopes of `kind`; the slopes laid, or `None` when no side fits.
-    fn cap_piece(&mut self, id: u32, kind: Shape) -> Option<usize> {
+    /// Swaps a run of the row of piece `id` along its side that falls most
+    /// for slopes of `kind`, then the bricks left of it the same way (a
+    /// ridge brick gets slopes on both sides); the slopes laid, or `None`
+    /// when no side fits.
+    fn cap_piece(
+        &mut self,
+        id: u32,
+        kind: Shape,
+        depth: u32,
+        budget: &mut Budget,
+    ) -> Option<usize> {
         let p = self.pieces[id as usize];
         let b = p.body.bbox;
         let up = kind == Shape::Slope;
-        // The sides with nothing over their row (under it, underneath), by
-        // how many columns beside them step by a brick.
+        // The sides by how many columns beside them step by a brick, with
+        // nothing over (under) the run of the row capped.
         let mut sides: Vec<(usize, (i32, i32))> = DIRS
             .iter()
             .filter(|&&d| self.side_bare(&b, d, up))
@@ -127,8 +332,16 @@ impl Layout<'_> {
             .collect();
         sides.sort_by_key(|&(k, d)| (std::cmp::Reverse(k), d));
         for (_, d) in sides {
-            if let Some(k) = self.swap_side(id, d, kind) {
-                return Some(k);
+            if let Some((k, rest)) = self.swap_side(id, d, kind, budget) {
+                let mut more = 0;
+                if depth < MAX_DEPTH {
+                    for r in rest {
+                        if self.pieces[r as usize].body.bbox.sz == 2 {
+                            more += self.cap_piece(r, kind, depth + 1, budget).unwrap_or(0);
+                        }
+                    }
+                }
+                return Some(k + more);
             }
         }
         None
@@ -215,67 +428,254 @@ impl Layout<'_> {
     }
 
     /// Takes piece `id` out and lays, in its place, slopes of `kind` along
-    /// its side facing `d` (back rows on that side, front rows beyond it)
-    /// and a shorter brick for the rest of it; puts it back if any part
-    /// does not fit or joins nothing through a rule. Returns the slopes
-    /// laid.
-    fn swap_side(&mut self, id: u32, d: (i32, i32), kind: Shape) -> Option<usize> {
+    /// a run of its side facing `d` (back rows on that side, front rows
+    /// beyond it) and bricks for the rest of it; puts it back if any part
+    /// does not fit, joins nothing through a rule, or the pieces the brick
+    /// joined would no longer be joined through the new ones. Returns the
+    /// slopes laid and the bricks laid for the rest.
+    fn swap_side(
+        &mut self,
+        id: u32,
+        d: (i32, i32),
+        kind: Shape,
+        budget: &mut Budget,
+    ) -> Option<(usize, Vec<u32>)> {
         let p = self.pieces[id as usize];
         let b = p.body.bbox;
         let side: Vec<Cell> = self.side_cells(&b, d).collect();
-        let width = side.len() as i32;
-        // The rest of the brick: its footprint less the side row.
-        let rest = match d {
-            (1, 0) => (b.sx > 1).then(|| CellBox { sx: b.sx - 1, ..b }),
-            (-1, 0) => (b.sx > 1).then(|| CellBox {
-                min: b.min.offset(1, 0, 0),
-                sx: b.sx - 1,
-                ..b
-            }),
-            (0, 1) => (b.sy > 1).then(|| CellBox { sy: b.sy - 1, ..b }),
-            _ => (b.sy > 1).then(|| CellBox {
-                min: b.min.offset(0, 1, 0),
-                sy: b.sy - 1,
-                ..b
-            }),
+        // 45° slopes (their back row on the side row) and 33° ones (their
+        // back two rows in the brick): the plan that adds the fewest pieces
+        // first, then the 45° one.
+        let mut plans: Vec<(usize, i32, Vec<Part>, usize)> = [2, 3]
+            .into_iter()
+            .filter_map(|deep| {
+                let (slopes, rest) = self.plan_swap(&b, d, kind, &side, deep)?;
+                let n = slopes.len();
+                let all: Vec<(Placement, Body)> = slopes.into_iter().chain(rest).collect();
+                Some((all.len(), deep, all, n))
+            })
+            .collect();
+        plans.sort_by_key(|&(n, deep, _, _)| (n, deep));
+        if plans.is_empty() {
+            return None;
+        }
+        // The pieces the brick joined, which the new ones must still join.
+        let joined: Vec<u32> = {
+            let mut v: Vec<u32> = self
+                .below(&p.body)
+                .into_iter()
+                .filter(|&o| self.joined_by_rule(o, id))
+                .collect();
+            v.extend(
+                self.above(&p.body)
+                    .into_iter()
+                    .filter(|&o| self.joined_by_rule(id, o)),
+            );
+            v
         };
-        // A 1x1 left over would only trade a brick for the smallest piece.
-        let rest_piece = match rest {
-            Some(r) if r.sx * r.sy == 1 => return None,
-            Some(r) => Some(self.brick_for(&r)?),
-            None => None,
+        self.remove(id);
+        for (n, _, all, slopes) in plans {
+            // Pieces it adds to the build: within the swap's and the whole
+            // pass's budget.
+            let added = n.saturating_sub(1);
+            if added > budget.per_swap || added > budget.pieces {
+                continue;
+            }
+            let fits = all.iter().all(|(pl, body)| self.swap_fits(pl, body));
+            if !fits || !self.still_joined(&all, &joined) {
+                continue;
+            }
+            budget.pieces -= added;
+            let mut rest = Vec::new();
+            for (placement, body) in all {
+                self.repairs.extra_cells += body.cells().filter(|&q| !self.must.get(q)).count();
+                let n = self.place(placement, body, None);
+                if body.is_box() {
+                    rest.push(n);
+                }
+            }
+            return Some((slopes, rest));
+        }
+        self.restore(id);
+        None
+    }
+
+    /// The slopes (`deep` rows deep, `deep - 1` of them in brick box `b`)
+    /// along `side`, the row of `b` facing `d`, and
+    /// the bricks for the rest of `b`; `None` if the alphabet has no such
+    /// slopes or no bricks for the rest.
+    fn plan_swap(
+        &self,
+        b: &CellBox,
+        d: (i32, i32),
+        kind: Shape,
+        side: &[Cell],
+        deep: i32,
+    ) -> Option<(Vec<Part>, Vec<Part>)> {
+        let rest = match rest_box(b, d, deep - 1)? {
+            Some(r) => self.bricks_for(&r)?,
+            None => Vec::new(),
         };
-        // Slopes along the side, longest first.
-        let along = side[0];
+        // Slopes along the run, longest first.
         let step = if d.0 != 0 { (0, 1) } else { (1, 0) };
-        let mut plan: Vec<(Placement, Body)> = Vec::new();
+        let mut slopes: Vec<(Placement, Body)> = Vec::new();
+        let width = side.len() as i32;
         let mut at = 0;
         while at < width {
             let left = width - at;
-            let start = along.offset(step.0 * at, step.1 * at, 0);
-            let (w, placed) = self.slope_for(start, step, left, d, kind, &b)?;
-            plan.push(placed);
+            let (w, placed) = self.slope_for(side[at as usize], step, left, d, kind, deep)?;
+            slopes.push(placed);
             at += w;
         }
-        self.remove(id);
-        let all: Vec<(Placement, Body)> = plan.iter().copied().chain(rest_piece).collect();
-        // What rested on the brick rests on what is left of it.
-        let held = rest_piece.is_none_or(|(pl, body)| {
-            self.above(&body).into_iter().all(|o| {
-                let a = &self.pieces[o as usize].placement;
-                self.book.joint(&pl, a, Dir::Up, self.layer_ldu).is_some()
-                    || self.book.joint(a, &pl, Dir::Down, self.layer_ldu).is_some()
+        Some((slopes, rest))
+    }
+
+    /// Whether the pieces `joined` (which a brick just taken out joined)
+    /// are still one through the pieces `new` about to be laid in its
+    /// place: every new piece and every one of `joined` meet through the
+    /// rules' joints of the new pieces.
+    fn still_joined(&self, new: &[(Placement, Body)], joined: &[u32]) -> bool {
+        let u = self.layer_ldu;
+        // The old pieces each new piece meets through a joint.
+        let met: Vec<Vec<u32>> = new
+            .iter()
+            .map(|(pl, body)| {
+                let mut v: Vec<u32> = Vec::new();
+                for o in self.below(body) {
+                    let a = &self.pieces[o as usize].placement;
+                    if self.book.joint(a, pl, Dir::Up, u).is_some()
+                        || self.book.joint(pl, a, Dir::Down, u).is_some()
+                    {
+                        v.push(o);
+                    }
+                }
+                for o in self.above(body) {
+                    let a = &self.pieces[o as usize].placement;
+                    if self.book.joint(pl, a, Dir::Up, u).is_some()
+                        || self.book.joint(a, pl, Dir::Down, u).is_some()
+                    {
+                        v.push(o);
+                    }
+                }
+                v
             })
-        });
-        if !held || !all.iter().all(|(pl, body)| self.swap_fits(pl, body)) {
-            self.restore(id);
-            return None;
+            .collect();
+        // A walk over the joints from the first new piece, through old
+        // pieces as far as `JOIN_WALK` of them, must meet every new piece
+        // and every one of `joined`.
+        let mut seen_new = vec![false; new.len()];
+        let mut seen: std::collections::HashSet<u32> = std::collections::HashSet::new();
+        let mut queue: std::collections::VecDeque<u32> = std::collections::VecDeque::new();
+        seen_new[0] = true;
+        let reach_new = |i: usize,
+                         seen: &mut std::collections::HashSet<u32>,
+                         queue: &mut std::collections::VecDeque<u32>| {
+            for &o in &met[i] {
+                if seen.insert(o) {
+                    queue.push_back(o);
+                }
+            }
+        };
+        reach_new(0, &mut seen, &mut queue);
+        let done = |seen_new: &[bool], seen: &std::collections::HashSet<u32>| {
+            seen_new.iter().all(|&s| s) && joined.iter().all(|o| seen.contains(o))
+        };
+        while let Some(o) = queue.pop_front() {
+            if done(&seen_new, &seen) {
+                return true;
+            }
+            if seen.len() > JOIN_WALK {
+                return false;
+            }
+            for (i, m) in met.iter().enumerate() {
+                if !seen_new[i] && m.contains(&o) {
+                    seen_new[i] = true;
+                    reach_new(i, &mut seen, &mut queue);
+                }
+            }
+            let body = self.pieces[o as usize].body;
+            let next: Vec<u32> = self
+                .below(&body)
+                .into_iter()
+                .filter(|&b| self.joined_by_rule(b, o))
+                .chain(
+                    self.above(&body)
+                        .into_iter()
+                        .filter(|&a| self.joined_by_rule(o, a)),
+                )
+                .collect();
+            for q in next {
+                if seen.insert(q) {
+                    queue.push_back(q);
+                }
+            }
         }
-        for (placement, body) in all {
-            self.repairs.extra_cells += body.cells().filter(|&q| !self.must.get(q)).count();
-            self.place(placement, body, None);
+        done(&seen_new, &seen)
+    }
+
+    /// Bricks of the alphabet, none 1x1, that fill `r` (one or two studs
+    /// wide) end to end, as few as can, longest first.
+    fn bricks_for(&self, r: &CellBox) -> Option<Vec<(Placement, Body)>> {
+        if let Some(one) = self.brick_for(r) {
+            return (r.sx * r.sy > 1).then(|| vec![one]);
         }
-        Some(plan.len())
+        let along_x = r.sx >= r.sy;
+        let (len, wide) = if along_x { (r.sx, r.sy) } else { (r.sy, r.sx) };
+        // The lengths of bricks `wide` studs wide, none 1x1.
+        let mut lengths: Vec<i32> = (1..=len)
+            .filter(|&l| wide * l > 1)
+            .filter(|&l| {
+                let (fx, fy) = if along_x { (l, wide) } else { (wide, l) };
+                self.shapes.iter().any(|s| {
+                    let spec = s.part.spec();
+                    spec.shape == Shape::Rect
+                        && spec.footprint(s.rot) == (fx, fy)
+                        && s.body_at(r.min).bbox.sz == r.sz
+                })
+            })
+            .collect();
+        lengths.sort_unstable_by(|a, b| b.cmp(a));
+        // Fewest pieces for each length, by the longest first piece.
+        let mut best: Vec<Option<Vec<i32>>> = vec![None; len as usize + 1];
+        best[0] = Some(Vec::new());
+        for l in 1..=len {
+            for &p in &lengths {
+                if p > l {
+                    continue;
+                }
+                if let Some(prev) = &best[(l - p) as usize] {
+                    if best[l as usize]
+                        .as_ref()
+                        .is_none_or(|cur| prev.len() + 1 < cur.len())
+                    {
+                        let mut v = vec![p];
+                        v.extend(prev);
+                        best[l as usize] = Some(v);
+                    }
+                }
+            }
+        }
+        let parts = best[len as usize].clone()?;
+        let mut out = Vec::new();
+        let mut at = 0;
+        for l in parts {
+            let piece = if along_x {
+                CellBox {
+                    min: r.min.offset(at, 0, 0),
+                    sx: l,
+                    ..*r
+                }
+            } else {
+                CellBox {
+                    min: r.min.offset(0, at, 0),
+                    sy: l,
+                    ..*r
+                }
+            };
+            out.push(self.brick_for(&piece)?);
+            at += l;
+        }
+        Some(out)
     }
 
     /// Whether a piece of a swap fits where the layout's own candidates
@@ -317,10 +717,10 @@ impl Layout<'_> {
         })
     }
 
-    /// The widest 45° slope of `kind` (two rows deep) of the alphabet, at
-    /// most `left` studs wide, whose back row starts at `start` and runs
-    /// `step`-wise, facing `d`, in the layers of `b`; its width and
-    /// placement.
+    /// The widest slope of `kind`, `deep` rows deep, of the alphabet, at
+    /// most `left` studs wide, whose row behind the front row starts at
+    /// `start` (its bottom layer) and runs `step`-wise, facing `d`; its
+    /// width and placement.
     fn slope_for(
         &self,
         start: Cell,
@@ -328,12 +728,13 @@ impl Layout<'_> {
         left: i32,
         d: (i32, i32),
         kind: Shape,
-        b: &CellBox,
-    ) -> Option<(i32, (Placement, Body))> {
+        deep: i32,
+    ) -> Option<(i32, Part)> {
         let mut best: Option<(i32, PartKind, Rot)> = None;
         for s in &self.shapes {
             let spec = s.part.spec();
-            if spec.shape != kind || spec.studs_y != 2 || spec.back(s.rot) != (-d.0, -d.1) {
+            if spec.shape != kind || spec.studs_y as i32 != deep || spec.back(s.rot) != (-d.0, -d.1)
+            {
                 continue;
             }
             let w = spec.studs_x as i32;
@@ -342,16 +743,63 @@ impl Layout<'_> {
             }
         }
         let (w, part, rot) = best?;
-        // The slope's box: the back row along the side, the front row one
-        // stud beyond it.
+        // The slope's box: its front row one stud beyond the side, the row
+        // behind it along the side, any other rows further into the brick.
         let end = start.offset(step.0 * (w - 1), step.1 * (w - 1), 0);
-        let front = (start.offset(d.0, d.1, 0), end.offset(d.0, d.1, 0));
+        let back = -(deep - 2);
+        let corners = [
+            start.offset(d.0, d.1, 0),
+            end.offset(d.0, d.1, 0),
+            start.offset(d.0 * back, d.1 * back, 0),
+            end.offset(d.0 * back, d.1 * back, 0),
+        ];
         let min = Cell::new(
-            start.x.min(end.x).min(front.0.x).min(front.1.x),
-            start.y.min(end.y).min(front.0.y).min(front.1.y),
-            b.min.z,
+            corners.iter().map(|c| c.x).min().unwrap_or(start.x),
+            corners.iter().map(|c| c.y).min().unwrap_or(start.y),
+            start.z,
         );
         let body = part.body(rot, min, self.layer_ldu);
         Some((w, (Placement::new(part, min, rot), body)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn brick(sx: i32, sy: i32) -> CellBox {
+        CellBox {
+            min: Cell::new(10, 20, 4),
+            sx,
+            sy,
+            sz: 2,
+        }
+    }
+
+    #[test]
+    fn the_rest_of_a_brick_is_the_rows_behind_the_side() {
+        // A 2x8 brick along x capped at its +x end by a 45° slope (one row
+        // in the brick): 7x2 left, at the brick's corner.
+        let b = brick(8, 2);
+        assert_eq!(rest_box(&b, (1, 0), 1), Some(Some(CellBox { sx: 7, ..b })));
+        // At its -x end by a 33° slope (two rows): 6x2 left, two studs in.
+        let r = CellBox {
+            min: Cell::new(12, 20, 4),
+            sx: 6,
+            ..b
+        };
+        assert_eq!(rest_box(&b, (-1, 0), 2), Some(Some(r)));
+        // Along its long side: one row left; both rows: none; three: the
+        // brick is too shallow.
+        assert_eq!(
+            rest_box(&b, (0, -1), 1),
+            Some(Some(CellBox {
+                min: Cell::new(10, 21, 4),
+                sy: 1,
+                ..b
+            }))
+        );
+        assert_eq!(rest_box(&b, (0, 1), 2), Some(None));
+        assert_eq!(rest_box(&b, (0, 1), 3), None);
     }
 }

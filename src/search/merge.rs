@@ -40,7 +40,7 @@ impl Layout<'_> {
 
     /// Merges piece `a` with its neighbour past its +x or +y side if their
     /// union is a piece of the alphabet; the neighbour merged, if any.
-    fn merge_with_neighbour(&mut self, a: u32) -> Option<u32> {
+    pub(super) fn merge_with_neighbour(&mut self, a: u32) -> Option<u32> {
         let pa = self.pieces[a as usize];
         if pa.placement.part.spec().shape != Shape::Rect || pa.group.is_some() {
             return None;
