@@ -167,7 +167,7 @@ fn solve_all_but(
 /// compression (each point under its centre of mass on a face of the piece
 /// below, down to the ground) still stands with the same
 /// clutch usage, the new pieces using none. Every other group is
-/// certified (see [`certify`](super::certify)): the equilibrium kept from
+/// certified (see the module docs, "Steps"): the equilibrium kept from
 /// the step before, changed near the new pieces, checked against every
 /// equation and bound; its pieces' usage is that equilibrium's. A group for
 /// which none exists fails; it is solved, and its program's answer says
