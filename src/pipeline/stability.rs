@@ -155,10 +155,14 @@ pub struct StabilityReport {
     pub complete: bool,
     /// Steps checked.
     pub steps_checked: usize,
-    /// Force analyses solved, and reused from the step before.
+    /// Force programs solved (whole groups).
     pub solves: usize,
-    /// Analyses reused.
+    /// Groups whose answer was reused from the step before, or whose new
+    /// pieces' weight drops straight to the table.
     pub reused: usize,
+    /// Groups certified standing by a change to the equilibrium of the
+    /// step before (see docs/stability.md).
+    pub certified: usize,
 }
 
 /// A planned build: the search's outcome and its verified, grouped
@@ -352,12 +356,14 @@ pub fn settle(
 struct Counts {
     solves: usize,
     reused: usize,
+    certified: usize,
 }
 
 impl Counts {
     fn add(&mut self, c: &StepsAnalysis) {
         self.solves += c.solves;
         self.reused += c.reused;
+        self.certified += c.certified;
     }
 }
 
@@ -814,6 +820,7 @@ fn report(
         steps_checked: check.steps.len(),
         solves: counts.solves,
         reused: counts.reused,
+        certified: counts.certified,
     }
 }
 
