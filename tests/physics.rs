@@ -540,14 +540,6 @@ fn every_step_of_a_real_build_agrees_with_a_full_solve() {
             fast.reused,
             fast.solves
         );
-        // Most steps are certified by a change near their new pieces.
-        assert!(
-            fast.certified + fast.reused > fast.solves,
-            "{name}: {} certified, {} reused, {} solved",
-            fast.certified,
-            fast.reused,
-            fast.solves
-        );
         let whole = analyze(&asm, &params).unwrap();
         for (a, b) in fast.last.pieces.iter().zip(&whole.pieces) {
             assert!((a.usage - b.usage).abs() <= 0.02, "{name}");

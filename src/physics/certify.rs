@@ -128,56 +128,13 @@ impl<'a> Certifier<'a> {
     /// pushed up first.
     fn contact_vars(&self, k: usize, out: &mut Vec<Var>) {
         let c = &self.s.contacts[k];
-        let mut at = self.coff[k];
-        if let Some(face) = c.face {
-            for point in face.corners() {
-                out.push(Var {
-                    at,
-                    point,
-                    up: c.above,
-                    down: Some(c.below),
-                    tension: false,
-                });
-                at += 1;
-            }
-        }
-        for &point in &c.studs {
-            out.push(Var {
-                at,
-                point,
-                up: c.above,
-                down: Some(c.below),
-                tension: true,
-            });
-            at += 1;
-        }
+        let (up, down) = (c.above, Some(c.below));
+        push_vars(self.coff[k], c.face, &c.studs, up, down, out);
     }
 
     fn ground_vars(&self, p: usize, out: &mut Vec<Var>) {
         let l = &self.s.loads[p];
-        let mut at = self.goff[p];
-        if let Some(g) = l.ground {
-            for point in g.corners() {
-                out.push(Var {
-                    at,
-                    point,
-                    up: p,
-                    down: None,
-                    tension: false,
-                });
-                at += 1;
-            }
-        }
-        for &point in &l.ground_studs {
-            out.push(Var {
-                at,
-                point,
-                up: p,
-                down: None,
-                tension: true,
-            });
-            at += 1;
-        }
+        push_vars(self.goff[p], l.ground, &l.ground_studs, p, None, out);
     }
 
     /// Piece `p`'s equations: its weight less the forces on it (vertical,
@@ -562,6 +519,30 @@ enum Found {
     None,
     /// The solver gave no answer.
     Trouble,
+}
+
+/// The forces from `at` of one contact (or ground) pushing `up` and, if
+/// any, `down`: compression at the corners of `face`, then a tension at
+/// each of `studs`.
+fn push_vars(
+    mut at: usize,
+    face: Option<Rect>,
+    studs: &[(f64, f64)],
+    up: usize,
+    down: Option<usize>,
+    out: &mut Vec<Var>,
+) {
+    let corners = face.iter().flat_map(|f| f.corners()).map(|p| (p, false));
+    for (point, tension) in corners.chain(studs.iter().map(|&p| (p, true))) {
+        out.push(Var {
+            at,
+            point,
+            up,
+            down,
+            tension,
+        });
+        at += 1;
+    }
 }
 
 /// +1 if force `v` pushes piece `p` up, -1 if down.

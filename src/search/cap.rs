@@ -243,13 +243,7 @@ impl Layout<'_> {
             && sb.shape == sa.shape
             && sb.studs_y == sa.studs_y
             && sb.back(pb.placement.rot) == back
-            && bb.min.z == ba.min.z
-            && bb.sz == ba.sz
-            && if dx > 0 {
-                bb.min.y == ba.min.y && bb.sy == ba.sy && bb.min.x == ba.min.x + ba.sx
-            } else {
-                bb.min.x == ba.min.x && bb.sx == ba.sx && bb.min.y == ba.min.y + ba.sy
-            };
+            && super::merge::continues(&ba, &bb, dx > 0);
         if !aligned {
             return None;
         }

@@ -55,14 +55,7 @@ impl Layout<'_> {
             if b == a || pb.placement.part.spec().shape != Shape::Rect || pb.group.is_some() {
                 continue;
             }
-            let aligned = bb.min.z == ba.min.z
-                && bb.sz == ba.sz
-                && if dx > 0 {
-                    bb.min.y == ba.min.y && bb.sy == ba.sy && bb.min.x == ba.min.x + ba.sx
-                } else {
-                    bb.min.x == ba.min.x && bb.sx == ba.sx && bb.min.y == ba.min.y + ba.sy
-                };
-            if !aligned {
+            if !continues(&ba, &bb, dx > 0) {
                 continue;
             }
             let union = CellBox {
@@ -121,4 +114,16 @@ impl Layout<'_> {
         }
         None
     }
+}
+
+/// Whether box `b` continues box `a` (same layers, same width) right after
+/// it along x (`along_x`) or along y: the two make one box.
+pub(super) fn continues(a: &CellBox, b: &CellBox, along_x: bool) -> bool {
+    b.min.z == a.min.z
+        && b.sz == a.sz
+        && if along_x {
+            b.min.y == a.min.y && b.sy == a.sy && b.min.x == a.min.x + a.sx
+        } else {
+            b.min.x == a.min.x && b.sx == a.sx && b.min.y == a.min.y + a.sy
+        }
 }
