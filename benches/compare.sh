@@ -4,7 +4,8 @@
 #   benches/compare.sh rules MESH...    learned rule frequencies (the built-in
 #       rules) against the same rules with every weight 1 ("uniform"):
 #       vertical seams that continue into the course above (lower is
-#       stronger), voxels per piece and search seconds.
+#       stronger), voxels per piece, how close the derivation's rule shares
+#       come to the corpus's, and search seconds.
 #   benches/compare.sh slopes MESH...   bricks alone against bricks and
 #       slopes (--slopes): bricks, slopes, voxels left out, seconds.
 #
@@ -36,26 +37,48 @@ PY
 case "$what" in
 rules)
   # The built-in rules, and the same rules with every weight 1; each mesh
-  # built with every seed of SEEDS, the figures averaged.
+  # built with every seed of SEEDS, the figures averaged. "TV to corpus" is
+  # the total variation distance between the derivations' shares of the
+  # basic rules (starting rules left out, all seeds together) and the
+  # corpus's shares (the learned counts) among the rules joining two
+  # bricks; "people's rules" is the share of the derivations' joints made
+  # by a rule the corpus used at all.
   cp rules/default.rules "$out/learned.rules"
   awk '$1 == "rule" { $8 = 1 } $1 == "unseen" { $2 = 1 } { print }' "$out/learned.rules" >"$out/uniform.rules"
   python3 - "$bin" "$out" "$studs" "${SEEDS:-1 2 3 4 5}" "$@" <<'PY'
 import json, subprocess, sys
 bin, out, studs, seeds, meshes = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(), sys.argv[5:]
-print(f"| mesh | weights | pieces | voxels/piece | seams continued | search s |  (mean of seeds {' '.join(seeds)})")
-print("|---|---|---|---|---|---|")
+lines = [l.split("#")[0].split() + [l] for l in open(f"{out}/learned.rules") if l.strip() and not l.startswith("#")]
+starts = sum(1 for t in lines if t[0] == "start")
+basic = [t for t in lines if t[0] == "rule"]
+bricks = {t[1] for t in lines if t[0] == "part" and "# Brick" in t[-1]}
+corpus = {starts + i: float(t[7]) for i, t in enumerate(basic) if t[1] in bricks and t[2] in bricks}
+total = sum(corpus.values())
+corpus = {k: v / total for k, v in corpus.items()}
+print(f"| mesh | weights | pieces | voxels/piece | seams continued | TV to corpus | people's rules | search s |  (mean of seeds {' '.join(seeds)})")
+print("|---|---|---|---|---|---|---|---|")
 for mesh in meshes:
     name = mesh.rsplit("/", 1)[-1]
     for w in ["learned", "uniform"]:
-        rows = []
+        rows, uses = [], {}
         for seed in seeds:
             d = f"{out}/{name}-{w}-{seed}"
             subprocess.run([bin, "build", mesh, "-o", d, "--studs", studs, "--seed", seed,
-                            "--rules", f"{out}/{w}.rules", "--quiet"], check=True)
-            rows.append(json.load(open(f"{d}/report.json")))
+                            "--rules", f"{out}/{w}.rules", "--stability", "off",
+                            "--formats", "ldr", "--quiet"], check=True)
+            r = json.load(open(f"{d}/report.json"))
+            rows.append(r)
+            for k, v in r["derivation"]["uses"].items():
+                if int(k) >= starts:
+                    uses[int(k)] = uses.get(int(k), 0) + v
+        n = sum(uses.values())
+        shares = {k: v / n for k, v in uses.items()}
+        tv = sum(abs(corpus.get(k, 0) - shares.get(k, 0)) for k in set(corpus) | set(shares)) / 2
+        seen = sum(v for k, v in shares.items() if k - starts < len(basic))
         mean = lambda f: sum(f(r) for r in rows) / len(rows)
         print(f"| {name} | {w} | {mean(lambda r: r['pieces']):.0f} | {mean(lambda r: r['voxels_per_piece']):.2f} "
-              f"| {mean(lambda r: r['seams']['fraction']):.3f} | {mean(lambda r: r['seconds']['search']):.2f} |")
+              f"| {mean(lambda r: r['seams']['fraction']):.3f} | {tv:.3f} | {seen:.0%} "
+              f"| {mean(lambda r: r['seconds']['search']):.2f} |")
 PY
   ;;
 slopes)

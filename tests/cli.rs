@@ -784,7 +784,7 @@ fn learned_rules_drive_a_build() {
     let (lo, hi) = (weights.iter().min().unwrap(), weights.iter().max().unwrap());
     assert_eq!(learned("counts"), format!("{lo} to {hi}"));
     assert!(
-        text.contains("\n#   house.ldr, post.mpd\n"),
+        text.contains("\n#   house.ldr: by brickwright\n#   post.mpd\n"),
         "the header names the builds:\n{text}"
     );
     assert!(text.contains("\nrule "), "{text}");

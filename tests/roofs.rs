@@ -171,8 +171,11 @@ fn a_steep_gable_roof_is_capped() {
     let path = dir.path().join("gable.obj");
     // Walls 3 high, the ridge 4 above them over a 4-unit run: 45°.
     std::fs::write(&path, gable_house(8.0, 10.0, 3.0, 4.0)).unwrap();
-    // 164 of 266: every course of a 45° roof is a row of slopes and the
+    // 132 of 269: every course of a 45° roof is a row of slopes and the
     // brick behind it, and the piece budget runs out before the ridge
-    // (see src/search/cap.rs).
-    check_roof(&path, 20, 0.6);
+    // (see src/search/cap.rs). The weights learned from people's models
+    // rarely set a 2x4 slope on bricks (people stack slopes on slopes), so
+    // the layout lays fewer slopes itself than with the earlier example
+    // corpus (164 of 266) and the cap pass's budget runs out sooner.
+    check_roof(&path, 20, 0.45);
 }

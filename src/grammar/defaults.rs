@@ -1,7 +1,9 @@
-//! The default rule set, generated from good building practice.
+//! The built-in rule file, and rule sets generated from good building
+//! practice.
 //!
-//! Until rule frequencies are learned from real builds, the weights encode
-//! what builder's guides teach (A. Bedford, *The Unofficial LEGO Builder's
+//! The built-in rules ([`default_rules_text`]) are learned from 30 models
+//! people built. The generated sets (`brickwright rules`) weigh their rules
+//! instead by what builder's guides teach (A. Bedford, *The Unofficial LEGO Builder's
 //! Guide*, ch. 2 "staggering" and "overlapping"): a joint that bridges a seam
 //! holds better than bricks stacked seam on seam, and a bigger brick holds
 //! more studs. A rule `A -> A + B` weighs
@@ -209,9 +211,9 @@ fn shipped_complex(set: &RuleSet) -> Vec<super::ComplexRule> {
 }
 
 /// The text of the shipped default rule file `rules/default.rules`: rule
-/// frequencies learned by `brickwright learn` from the example builds in
-/// `rules/examples/` (`tests/default_rules.rs` checks that learning them
-/// again gives this file byte for byte).
+/// frequencies learned by `brickwright learn` from 30 LDraw models people
+/// built (official set models and Datsville's buildings; its header credits
+/// each model's authors and licence; `benches/learn.sh` learns it again).
 pub fn default_rules_text() -> String {
     include_str!("../../rules/default.rules").to_string()
 }

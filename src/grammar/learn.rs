@@ -195,6 +195,17 @@ impl BuildSkips {
     }
 }
 
+/// Who made a build and under which licence, as its file says.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Credit {
+    /// The build, as given.
+    pub file: PathBuf,
+    /// Its `0 Author:` lines, each once.
+    pub authors: Vec<String>,
+    /// Its `0 !LICENSE` line, if any.
+    pub licence: Option<String>,
+}
+
 /// What was read and what was left out.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct LearnReport {
@@ -212,6 +223,8 @@ pub struct LearnReport {
     pub empty_builds: Vec<(PathBuf, String)>,
     /// The builds read, as given, in the order read.
     pub builds: Vec<PathBuf>,
+    /// Who made each build read and under which licence, in the order read.
+    pub credits: Vec<Credit>,
     /// Submodel instances built separately inside them.
     pub submodel_builds: usize,
     /// Part references read, catalog parts or not.
@@ -404,6 +417,11 @@ impl Learner {
         r.packed_parts += mine.packed_parts;
         r.per_build.push(mine);
         r.builds.push(model.path.clone());
+        r.credits.push(Credit {
+            file: model.path.clone(),
+            authors: model.authors.clone(),
+            licence: model.licence.clone(),
+        });
         r.submodel_builds += model.instances.len() - 1;
         r.pieces += model.parts.len();
         r.learned_pieces += placed.len();
@@ -716,29 +734,23 @@ impl Learned {
         Some((*min, *max))
     }
 
-    /// The rule file: a header naming the builds (file names only, sorted)
-    /// and the totals, then the rules with their counts as weights.
+    /// The rule file: a header naming the builds (file names only, sorted),
+    /// with the authors and licence each file names, and the totals, then the rules with their counts as weights.
     /// [`RuleSet::parse`] reads it back to [`Learned::rule_set`].
     pub fn to_rules_text(&self) -> String {
         let r = &self.report;
-        let mut names: Vec<String> = r
-            .builds
-            .iter()
-            .map(|p| match p.file_name() {
-                Some(n) => n.to_string_lossy().into_owned(),
-                None => p.display().to_string(),
-            })
-            .collect();
-        names.sort();
         let mut h = String::new();
         h.push_str("brickwright rule file: the Lego rewriting system (Σ, R).\n");
         let _ = writeln!(
             h,
-            "Learned by `brickwright learn` from {} ({}):",
+            "Learned by `brickwright learn` from {} ({}),\n\
+             with the authors and licences their files name:",
             plural(r.builds.len(), "build"),
             plural(r.submodel_builds, "separately built submodel")
         );
-        for line in wrap(&names, 74) {
+        let mut credits: Vec<String> = r.credits.iter().map(credit_line).collect();
+        credits.sort();
+        for line in credits {
             let _ = writeln!(h, "  {line}");
         }
         let unknown = r.pieces - r.learned_pieces - r.tilted - r.off_grid;
@@ -900,6 +912,23 @@ impl Learned {
     }
 }
 
+/// One build's credit: `NAME: by AUTHOR, AUTHOR; LICENCE`, the parts its
+/// file does not name left out.
+fn credit_line(c: &Credit) -> String {
+    let mut line = match c.file.file_name() {
+        Some(n) => n.to_string_lossy().into_owned(),
+        None => c.file.display().to_string(),
+    };
+    if !c.authors.is_empty() {
+        let _ = write!(line, ": by {}", c.authors.join(", "));
+    }
+    if let Some(l) = &c.licence {
+        line.push_str(if c.authors.is_empty() { ": " } else { "; " });
+        line.push_str(l);
+    }
+    line
+}
+
 /// `n thing` or `n things`.
 fn plural(n: usize, thing: &str) -> String {
     plural_u64(n as u64, thing)
@@ -925,30 +954,6 @@ fn thousands(n: u64) -> String {
         out.push(c);
     }
     out
-}
-
-/// `names` joined with `, ` into lines of at most about `width` characters.
-fn wrap(names: &[String], width: usize) -> Vec<String> {
-    let mut lines: Vec<String> = Vec::new();
-    let mut line = String::new();
-    for (i, name) in names.iter().enumerate() {
-        let piece = if i + 1 < names.len() {
-            format!("{name},")
-        } else {
-            name.clone()
-        };
-        if !line.is_empty() && line.len() + 1 + piece.len() > width {
-            lines.push(std::mem::take(&mut line));
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(&piece);
-    }
-    if !line.is_empty() {
-        lines.push(line);
-    }
-    lines
 }
 
 #[cfg(test)]

@@ -49,6 +49,12 @@ const INHERIT_COLOUR: Color = Color(16);
 /// The finest vertical step, in LDU, a piece may sit at: half a plate.
 const Y_GRID_LDU: f64 = 4.0;
 
+/// `0 Author:` lines kept a section; more are ignored.
+const MAX_AUTHORS: usize = 16;
+
+/// Characters kept of an `0 Author:` or `0 !LICENSE` line.
+const MAX_CREDIT_CHARS: usize = 200;
+
 /// One part reference of a flattened model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PartRef {
@@ -101,6 +107,12 @@ pub struct LdrModel {
     /// `0 !LDRAW_ORG Part`, `Subpart`, `Primitive`, ...): never expanded,
     /// a reference to one is a part reference.
     pub packed_parts: usize,
+    /// The authors its model sections name (`0 Author:` lines outside
+    /// packed part definitions), each once, in file order.
+    pub authors: Vec<String>,
+    /// The licence its model sections state (the first `0 !LICENSE` line
+    /// outside packed part definitions), if any.
+    pub licence: Option<String>,
 }
 
 /// Reads and parses the LDraw (`.ldr` or `.mpd`) file at `path`.
@@ -143,11 +155,20 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
             Cmd::Ref(r) => flat.expand(r, &Xform::IDENTITY, INHERIT_COLOUR, step, 0)?,
         }
     }
+    let models = || file.sections.iter().filter(|s| !s.part);
+    let mut authors: Vec<String> = Vec::new();
+    for a in models().flat_map(|s| &s.authors) {
+        if !authors.contains(a) {
+            authors.push(a.clone());
+        }
+    }
     Ok(LdrModel {
         path: path.to_path_buf(),
         parts,
         instances,
         packed_parts: file.sections.iter().filter(|s| s.part).count(),
+        authors,
+        licence: models().find_map(|s| s.licence.clone()),
     })
 }
 
@@ -379,6 +400,10 @@ struct Section {
     /// `Primitive`, ...), as packed files inline the official parts they
     /// use: a reference to it is a part, not a submodel.
     part: bool,
+    /// Its `0 Author:` lines, as written.
+    authors: Vec<String>,
+    /// Its first `0 !LICENSE` line, as written.
+    licence: Option<String>,
 }
 
 /// The sections of a file, with the main one and a lookup by name.
@@ -473,6 +498,26 @@ fn parse_sections(text: &str, path: &Path) -> Result<File, LdrError> {
                 Some((word, kind)) if word.eq_ignore_ascii_case("!LDRAW_ORG") => {
                     if let (Some(Some(idx)), true) = (current, defines_part(kind)) {
                         sections[idx].part = true;
+                    }
+                    continue;
+                }
+                Some((word, said))
+                    if word.eq_ignore_ascii_case("Author:")
+                        || word.eq_ignore_ascii_case("!LICENSE") =>
+                {
+                    let said: String = said.trim().chars().take(MAX_CREDIT_CHARS).collect();
+                    let section = match current {
+                        Some(Some(idx)) => &mut sections[idx],
+                        Some(None) => &mut preamble,
+                        None => continue,
+                    };
+                    if said.is_empty() {
+                        continue;
+                    }
+                    if word.eq_ignore_ascii_case("!LICENSE") {
+                        section.licence.get_or_insert(said);
+                    } else if section.authors.len() < MAX_AUTHORS {
+                        section.authors.push(said);
                     }
                     continue;
                 }

@@ -19,7 +19,9 @@
 //! - **the rules' weights**: the piece joins a piece below through a rule
 //!   of the loaded file (a candidate that joins the pieces below through no
 //!   rule is not a candidate), and `ln(weight / mean weight)` of the
-//!   heaviest such rule is added;
+//!   heaviest such rule is added, the mean over the rules the piece's part
+//!   takes part in (how people join that part, not how often they use it:
+//!   the shape chooses the parts, the rules how they bond);
 //! - **courses**: a long piece laid along the course's direction earns
 //!   (directions alternate course to course, so walls and solids bond);
 //! - **no small leftovers**: a free voxel the piece would leave with no free
@@ -69,7 +71,7 @@ pub(crate) struct Weights {
     pub merge: f64,
     /// Resting on nothing above the ground.
     pub loose: f64,
-    /// Times `ln(weight / mean weight)` of the rule.
+    /// Times `ln(weight / mean weight of the part's joints)` of the rule.
     pub rule: f64,
     /// A long piece along the course's direction.
     pub along: f64,
@@ -837,9 +839,13 @@ impl<'a> Layout<'a> {
         let mut rule_w: Option<f64> = None;
         for &o in &below {
             let a = &self.pieces[o as usize].placement;
-            let up = self.book.joint(a, &placement, Dir::Up, self.layer_ldu);
-            let down = self.book.joint(&placement, a, Dir::Down, self.layer_ldu);
-            for (wt, _) in up.into_iter().chain(down) {
+            let up = self
+                .book
+                .typical(a, &placement, Dir::Up, self.layer_ldu, shape.part);
+            let down = self
+                .book
+                .typical(&placement, a, Dir::Down, self.layer_ldu, shape.part);
+            for wt in up.into_iter().chain(down) {
                 rule_w = Some(rule_w.map_or(wt, |r: f64| r.max(wt)));
             }
         }
@@ -855,7 +861,7 @@ impl<'a> Layout<'a> {
         }
         let mut score = w.size * inside as f64 - w.near * near as f64 - w.far * far as f64;
         if let Some(wt) = rule_w {
-            score += w.rule * (wt / self.book.mean).ln();
+            score += w.rule * wt.ln();
         }
         let z = origin.z;
         if below.is_empty() && z > 0 {

@@ -13,8 +13,9 @@ type Key = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
 /// Every basic rule variant by the joint it makes.
 pub(crate) struct RuleBook {
     joints: HashMap<Key, (f64, RuleId)>,
-    /// The mean weight of a variant: scores use weights relative to it.
-    pub mean: f64,
+    /// Per part: the mean weight of the variants it takes part in (as the
+    /// piece in place or the piece added).
+    means: HashMap<PartKind, f64>,
 }
 
 impl RuleBook {
@@ -22,7 +23,7 @@ impl RuleBook {
     /// joint, the heavier one stands for it.
     pub fn new(rules: &RuleSet) -> RuleBook {
         let mut joints: HashMap<Key, (f64, RuleId)> = HashMap::new();
-        let mut sum = 0.0;
+        let mut sums: HashMap<PartKind, (f64, usize)> = HashMap::new();
         for v in rules.variants() {
             let key = (
                 v.anchor,
@@ -32,17 +33,37 @@ impl RuleBook {
                 v.offset,
                 v.dir,
             );
-            sum += v.weight;
+            for part in [v.anchor, v.added] {
+                let s = sums.entry(part).or_default();
+                s.0 += v.weight;
+                s.1 += 1;
+            }
             let e = joints.entry(key).or_insert((v.weight, v.rule));
             if v.weight > e.0 || (v.weight == e.0 && v.rule < e.1) {
                 *e = (v.weight, v.rule);
             }
         }
-        let n = rules.variants().len().max(1) as f64;
-        RuleBook {
-            joints,
-            mean: (sum / n).max(f64::MIN_POSITIVE),
-        }
+        let means = sums
+            .into_iter()
+            .map(|(part, (sum, n))| (part, (sum / n as f64).max(f64::MIN_POSITIVE)))
+            .collect();
+        RuleBook { joints, means }
+    }
+
+    /// The joint that adds `added` to `anchor` (as [`RuleBook::joint`]),
+    /// its weight relative to the mean weight of the joints `part` (one of
+    /// the two) takes part in: how typical the joint is of the way people
+    /// join that part, whatever how often they use the part itself.
+    pub fn typical(
+        &self,
+        anchor: &Placement,
+        added: &Placement,
+        dir: Dir,
+        layer_ldu: i32,
+        part: PartKind,
+    ) -> Option<f64> {
+        let (w, _) = self.joint(anchor, added, dir, layer_ldu)?;
+        Some(w / self.means.get(&part).copied().unwrap_or(1.0))
     }
 
     /// The rule that adds `added` to `anchor` in place, on top of it

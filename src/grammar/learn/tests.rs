@@ -465,8 +465,10 @@ fn the_rule_file_names_the_builds_and_round_trips() {
     );
     assert!(
         file.contains(
-            "# Learned by `brickwright learn` from 2 builds (1 separately built submodel):\n\
-             #   a.ldr, b.ldr\n"
+            "# Learned by `brickwright learn` from 2 builds (1 separately built submodel),\n\
+             # with the authors and licences their files name:\n\
+             #   a.ldr\n\
+             #   b.ldr\n"
         ),
         "{file}"
     );
@@ -845,13 +847,34 @@ fn summary_sets_the_totals_beside_the_papers() {
     );
     assert_eq!(thousands(1_234_567), "1,234,567");
     assert_eq!(thousands(999), "999");
-    let names: Vec<String> = (0..30).map(|i| format!("build-{i:02}.ldr")).collect();
-    let lines = wrap(&names, 74);
-    assert!(
-        lines.len() > 1 && lines.iter().all(|l| l.len() <= 74),
-        "{lines:#?}"
+}
+
+/// The rule file credits each build's authors and licence, as its file
+/// names them, and only its model sections' (not packed parts').
+#[test]
+fn the_rule_file_credits_the_builds_authors_and_licences() {
+    let text = "0 FILE wall.ldr\n0 Author: Ann Builder [ann]\n\
+        0 !LICENSE Redistributable under CC BY-SA version 4.0\n\
+        1 4 0 -24 0 1 0 0 0 1 0 0 0 1 3001.dat\n\
+        1 4 40 -48 0 1 0 0 0 1 0 0 0 1 3001.dat\n1 4 0 0 0 1 0 0 0 1 0 0 0 1 sub.ldr\n\
+        0 FILE sub.ldr\n0 Author: Bo Second\n0 Author: Ann Builder [ann]\n\
+        1 4 0 -72 0 1 0 0 0 1 0 0 0 1 3001.dat\n\
+        0 FILE 3001.dat\n0 Author: Part Maker\n0 !LDRAW_ORG Part\n\
+        0 !LICENSE Parts licence\n";
+    let l = learn_one(text);
+    assert_eq!(
+        l.report.credits[0].authors,
+        vec!["Ann Builder [ann]".to_string(), "Bo Second".to_string()]
     );
-    assert_eq!(lines.join(" "), names.join(", "));
+    let rules = l.to_rules_text();
+    assert!(
+        rules.contains(
+            "#   t.ldr: by Ann Builder [ann], Bo Second; \
+             Redistributable under CC BY-SA version 4.0\n"
+        ),
+        "{rules}"
+    );
+    assert!(!rules.contains("Part Maker") && !rules.contains("Parts licence"));
 }
 
 #[test]
