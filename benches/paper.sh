@@ -4,13 +4,14 @@
 # 1-5, one line a run: model, search, seed, bricks (pieces), tree nodes,
 # backtracks, search seconds, success. Sizes (--studs) are chosen so the
 # layout's piece count is near the paper's brick count: house 61 bricks
-# (43 bricks and 24 slopes with slopes), skyscraper 92, mug 132.
+# (43 bricks and 24 slopes with slopes), skyscraper 92, mug 132, shuttle
+# 111.
 # Usage: benches/paper.sh. SEEDS (default "1 2 3 4 5"), BUDGET (backward
 # time budget in seconds, default 60), NODES (backward node budget, default
 # 1000000) and BIN (a brickwright binary; default: this tree's, built)
-# override. The stand-ins: fixtures/house.obj for the house,
-# fixtures/tower.glb (a box under a taller narrower box) for the skyscraper,
-# fixtures/mug.obj for the mug. There is no shuttle fixture yet.
+# override. The models: fixtures/house.obj, fixtures/skyscraper.obj (five
+# setback tiers), fixtures/mug.obj and fixtures/shuttle.obj (a fuselage,
+# two delta wings and a fin).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 seeds=${SEEDS:-"1 2 3 4 5"}
@@ -26,8 +27,9 @@ trap 'rm -rf "$out"' EXIT
 models=(
     "house|fixtures/house.obj|12|"
     "house, slopes|fixtures/house.obj|11|--slopes"
-    "skyscraper|fixtures/tower.glb|14|"
+    "skyscraper|fixtures/skyscraper.obj|12|"
     "mug|fixtures/mug.obj|15|"
+    "shuttle|fixtures/shuttle.obj|28|"
 )
 printf '| model | search | seed | bricks | nodes | backtracks | search s | success |\n'
 printf '|---|---|---|---|---|---|---|---|\n'

@@ -101,6 +101,21 @@ impl Mesh {
         }
     }
 
+    /// Extrudes a simple counter-clockwise polygon of `(x, z)` points from
+    /// `y0` to `y1` (`y0 < y1`) into a closed prism: [`Mesh::extrude`] with
+    /// y and z swapped (a mirror, so each triangle is turned back).
+    pub fn extrude_y(&mut self, profile: &[[f64; 2]], y0: f64, y1: f64) {
+        let mut prism = Mesh::default();
+        prism.extrude(profile, y0, y1);
+        for t in &prism.triangles {
+            let [a, b, c] = t.map(|i| {
+                let p = prism.positions[i as usize].map(unquantize);
+                self.vertex([p[0], p[2], p[1]])
+            });
+            self.triangle(a, c, b);
+        }
+    }
+
     /// Adds the closed axis-aligned box from `min` to `max`.
     pub fn add_box(&mut self, min: [f64; 3], max: [f64; 3]) {
         let rect = [
@@ -114,7 +129,7 @@ impl Mesh {
 }
 
 /// Twice the signed area of a polygon (positive when counter-clockwise).
-fn twice_area(poly: &[[f64; 2]]) -> f64 {
+pub fn twice_area(poly: &[[f64; 2]]) -> f64 {
     (0..poly.len())
         .map(|i| {
             let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);

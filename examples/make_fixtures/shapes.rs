@@ -7,7 +7,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use crate::mesh::{ngon_area, Mesh};
+use crate::mesh::{ngon_area, twice_area, Mesh};
 
 /// A closed shape and the volumes its shells must have.
 pub struct Shape {
@@ -34,6 +34,8 @@ pub fn all() -> Vec<Shape> {
         arch(),
         floating(),
         wedge(),
+        skyscraper(),
+        shuttle(),
     ]
 }
 
@@ -135,6 +137,71 @@ fn wedge() -> Shape {
         file: "wedge.stl",
         mesh,
         expected: vec![(12.0, EXACT)],
+    }
+}
+
+/// The paper's skyscraper (Lau et al., Figure 6): five setback tiers, each a
+/// box centred on the y axis standing on the one below, which it touches
+/// face to face (separate shells, no overlap): (width x, depth z, height).
+const SKYSCRAPER_TIERS: [(f64, f64, f64); 5] = [
+    (8.0, 6.0, 3.0),
+    (6.0, 5.0, 3.0),
+    (5.0, 4.0, 3.0),
+    (4.0, 3.0, 3.0),
+    (2.0, 2.0, 2.0),
+];
+
+/// A skyscraper in five parts: [`SKYSCRAPER_TIERS`] stacked, 14 high.
+fn skyscraper() -> Shape {
+    let mut mesh = Mesh::default();
+    let mut y = 0.0;
+    let mut expected = Vec::new();
+    for (w, d, h) in SKYSCRAPER_TIERS {
+        mesh.add_box([-w / 2.0, y, -d / 2.0], [w / 2.0, y + h, d / 2.0]);
+        expected.push((w * d * h, EXACT));
+        y += h;
+    }
+    Shape {
+        file: "skyscraper.obj",
+        mesh,
+        expected,
+    }
+}
+
+/// A space shuttle lying along x, nose at +x, standing on its belly: a
+/// fuselage (a side profile 12 long and 2.6 high with a sloped nose,
+/// extruded 2.5 wide), two delta wings 0.5 thick touching its sides, and a
+/// tail fin 0.5 thick standing on its back. Four shells, touching, none
+/// overlapping.
+fn shuttle() -> Shape {
+    let body = [
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [12.0, 0.8],
+        [11.0, 2.0],
+        [9.0, 2.6],
+        [0.0, 2.6],
+    ];
+    let half = 1.25;
+    let right_wing = [[1.0, half], [7.0, half], [1.5, 5.0], [0.5, 5.0]];
+    let left_wing = [[1.0, -half], [0.5, -5.0], [1.5, -5.0], [7.0, -half]];
+    let fin = [[0.0, 2.6], [2.5, 2.6], [0.8, 5.0], [0.0, 5.0]];
+    let mut mesh = Mesh::default();
+    mesh.extrude(&body, -half, half);
+    mesh.extrude_y(&right_wing, 0.0, 0.5);
+    mesh.extrude_y(&left_wing, 0.0, 0.5);
+    mesh.extrude(&fin, -0.25, 0.25);
+    let area = |p: &[[f64; 2]]| twice_area(p).abs() / 2.0;
+    let wing = area(&right_wing) * 0.5;
+    Shape {
+        file: "shuttle.obj",
+        mesh,
+        expected: vec![
+            (area(&body) * 2.0 * half, EXACT),
+            (wing, EXACT),
+            (wing, EXACT),
+            (area(&fin) * 0.5, EXACT),
+        ],
     }
 }
 
