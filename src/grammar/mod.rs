@@ -351,8 +351,8 @@ impl RuleSet {
         }
         let mut mine: Vec<Variant> = Vec::new();
         for turn in Rot::ALL {
-            let ra = a.turned(turn).bbox;
-            let rb = b0.turned(turn).bbox;
+            let ra = a.bbox.turned(turn);
+            let rb = b0.bbox.turned(turn);
             let v = Variant {
                 rule: id,
                 anchor: r.anchor,

@@ -1,29 +1,29 @@
 //! The rules of a [`RuleSet`] indexed by the joint they make: given a piece
 //! in place and a piece to add, which rule adds it, and with what weight.
 
-use std::collections::HashMap;
-
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::Rot;
 use crate::grammar::{Dir, RuleId, RuleSet};
+use crate::keyhash::KeyMap;
 
 type Key = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
 
 /// Every basic rule variant by the joint it makes.
 pub(crate) struct RuleBook {
-    joints: HashMap<Key, (f64, RuleId)>,
+    joints: KeyMap<Key, (f64, RuleId)>,
     /// Per part: the mean weight of the variants it takes part in (as the
     /// piece in place or the piece added).
-    means: HashMap<PartKind, f64>,
+    means: KeyMap<PartKind, f64>,
 }
 
 impl RuleBook {
     /// Indexes every variant of `rules`; where two rules make the same
     /// joint, the heavier one stands for it.
     pub fn new(rules: &RuleSet) -> RuleBook {
-        let mut joints: HashMap<Key, (f64, RuleId)> = HashMap::new();
-        let mut sums: HashMap<PartKind, (f64, usize)> = HashMap::new();
+        let mut joints: KeyMap<Key, (f64, RuleId)> =
+            KeyMap::with_capacity_and_hasher(rules.variants().len(), Default::default());
+        let mut sums: KeyMap<PartKind, (f64, usize)> = KeyMap::default();
         for v in rules.variants() {
             let key = (
                 v.anchor,
