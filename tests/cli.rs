@@ -222,6 +222,8 @@ fixtures_build! {
     builds_vertex_colors: "vertex_colors.obj",
     builds_textured: "textured.glb",
     builds_speckled: "speckled.glb",
+    builds_skyscraper: "skyscraper.obj",
+    builds_shuttle: "shuttle.obj",
 }
 
 /// The `1` lines of an LDraw file whose part is one of `ids`.
