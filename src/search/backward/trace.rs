@@ -23,9 +23,10 @@
 //! to one), except the first,
 //! and its new piece must be able to reach its place past what is built
 //! before it ([`super::fit`]). A node whose voxels fall apart, or that was
-//! met before and failed with every rule tried, is cut off; a node with
-//! no child left is
-//! backtracked from.
+//! met before and failed with every rule tried, is cut off, and so is a
+//! node this pass has searched already, reached again by taking the same
+//! pieces in another order (it stays open to the next pass); a node with
+//! no child left is backtracked from.
 
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
@@ -230,6 +231,8 @@ impl<'a> Trace<'a> {
         count: &mut Counters,
     ) -> Result<Option<Vec<Removal>>, Stop> {
         let mut log: Vec<Change> = Vec::new();
+        // The nodes whose subtrees this pass searched to the end, by state.
+        let mut exhausted: HashSet<u64> = HashSet::new();
         let root = self.frame(rng, count, None);
         let mut stack = vec![root];
         loop {
@@ -277,6 +280,17 @@ impl<'a> Trace<'a> {
                         self.undo(&c);
                         continue;
                     }
+                    // The same pieces taken and matched, reached before in
+                    // another order: searched already in this pass (with
+                    // the rules drawn there), so not again; the node stays
+                    // open to the next pass.
+                    if exhausted.contains(&self.hash) {
+                        self.undo(&c);
+                        if let Some(top) = stack.last_mut() {
+                            top.whole = false;
+                        }
+                        continue;
+                    }
                     if matches!(c.rule, RuleRef::Complex(_)) {
                         count.complex_applied += 1;
                     }
@@ -292,6 +306,8 @@ impl<'a> Trace<'a> {
                     let whole = done.complete && done.whole;
                     if whole {
                         self.failed.insert(self.hash);
+                    } else {
+                        exhausted.insert(self.hash);
                     }
                     match stack.last_mut() {
                         Some(parent) => parent.whole &= whole,
