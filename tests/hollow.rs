@@ -169,6 +169,22 @@ fn the_hollow_house_keeps_its_roof() {
     verified_with_stability(&tmp.path().join("house.ldr"));
 }
 
+/// The paper's skyscraper, hollow: each tier is set back on the one
+/// below, its walls over that one's hollow, so each tier below gets a lid;
+/// the whole model is built and verified.
+#[test]
+fn a_hollow_skyscraper_keeps_every_tier() {
+    let tmp = tempfile::tempdir().unwrap();
+    let model = solid("skyscraper.obj", 32);
+    let out = build("skyscraper.obj", 32, Some(2), tmp.path());
+    let cells = filled(&out.assembly, model.dims());
+    roof_kept(&model, &cells);
+    assert_eq!(out.report.quality.left_out, 0, "{:?}", out.report.quality);
+    let h = out.report.hollow.as_ref().unwrap();
+    assert!(h.emptied_voxels * 4 > model.count(), "{h:?}");
+    verified_with_stability(&tmp.path().join("skyscraper.ldr"));
+}
+
 #[test]
 fn at_44_studs_inner_pillars_hold_the_house_roof_and_go_in_before_it_closes() {
     let tmp = tempfile::tempdir().unwrap();

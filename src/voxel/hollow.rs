@@ -18,6 +18,12 @@
 //! - Pockets narrower than [`MIN_HOLE`] studs are filled again: a slot
 //!   under a ridge costs more pieces, short ones bridging it, than it
 //!   saves.
+//! - Nothing of the shell hangs over the hollow with nothing under it: a
+//!   part of a layer's shell none of whose cells has shell under it, over
+//!   the hollow (the walls of a tier set back on the tier below, whose
+//!   middle is hollow), gets a lid under it: the hollow it lies over is
+//!   filled again for a lid's thickness, across the whole stretch of
+//!   hollow in each of those layers, so the lid rests on the walls below.
 //!
 //! What holds a lid or a roof over the hollow is decided later, by the
 //! stability stage, which adds inner pillars where the statics need them.
@@ -96,12 +102,80 @@ pub fn hollow(solid: &VoxelGrid, wall: Wall, course: i32, min_lid: i32) -> Hollo
             inner.set(c, true);
         }
     }
-    let emptied = open_square(&inner);
+    let mut emptied = open_square(&inner);
     let mut shell = solid.clone();
     for c in emptied.cells() {
         shell.set(c, false);
     }
+    lid_under_hanging(&mut shell, &mut emptied, up);
     Hollowed { shell, emptied }
+}
+
+/// The four neighbours of a cell in its layer.
+const SIDES: [(i32, i32); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
+
+/// The cells of `g` joined to `start` side by side in its layer (`start`
+/// included if in `g`).
+fn layer_part(g: &VoxelGrid, start: Cell) -> Vec<Cell> {
+    if !g.in_bounds(start) || !g.get(start) {
+        return Vec::new();
+    }
+    let (nx, ny, _) = g.dims();
+    let mut seen = vec![false; (nx * ny) as usize];
+    let at = |c: Cell| (c.y * nx + c.x) as usize;
+    seen[at(start)] = true;
+    let mut stack = vec![start];
+    let mut out = Vec::new();
+    while let Some(c) = stack.pop() {
+        out.push(c);
+        for (dx, dy) in SIDES {
+            let d = c.offset(dx, dy, 0);
+            if g.in_bounds(d) && !seen[at(d)] && g.get(d) {
+                seen[at(d)] = true;
+                stack.push(d);
+            }
+        }
+    }
+    out
+}
+
+/// Gives every part of a layer's shell that hangs wholly over the hollow
+/// (no cell of it has shell under it, and some has hollow) a lid of `up`
+/// layers under it: in each of those layers, the stretch of hollow under
+/// its cells is filled again, whole (see the module docs). Layers go from
+/// the bottom up, so a lid made is in place when the layers above it are
+/// looked at.
+fn lid_under_hanging(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
+    let (nx, ny, nz) = shell.dims();
+    for z in 1..nz {
+        let mut looked = vec![false; (nx * ny) as usize];
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = Cell::new(x, y, z);
+                if looked[(y * nx + x) as usize] || !shell.get(c) {
+                    continue;
+                }
+                let part = layer_part(shell, c);
+                for q in &part {
+                    looked[(q.y * nx + q.x) as usize] = true;
+                }
+                let held = part.iter().any(|q| shell.get(q.offset(0, 0, -1)));
+                let over_hollow = part.iter().any(|q| emptied.get(q.offset(0, 0, -1)));
+                if held || !over_hollow {
+                    continue;
+                }
+                for k in 1..=up.min(z) {
+                    for q in &part {
+                        let below = Cell::new(q.x, q.y, z - k);
+                        for h in layer_part(emptied, below) {
+                            emptied.set(h, false);
+                            shell.set(h, true);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Per cell (by [`VoxelGrid::index`]): the chessboard distance, within its
@@ -252,6 +326,47 @@ mod tests {
         // 8 deep: a pocket 4 studs wide, kept.
         let wide = hollow(&block(20, 8, 8), Wall::DEFAULT, 1, 2);
         assert_eq!(wide.emptied.count(), 16 * 4 * 6);
+    }
+
+    /// A tower on a wider base, set back so far that its walls stand
+    /// wholly over the base's hollow: the base gets a lid under them, a
+    /// whole one (the walls rest on it and it on the base's walls), and the
+    /// tower above is hollow again.
+    #[test]
+    fn walls_set_back_over_the_hollow_get_a_lid_under_them() {
+        let mut g = block(20, 20, 16);
+        // The base is 20 x 20 and 8 high; the tower 8 x 8 in its middle.
+        for z in 8..16 {
+            for y in 0..20 {
+                for x in 0..20 {
+                    if !(6..14).contains(&x) || !(6..14).contains(&y) {
+                        g.set(Cell::new(x, y, z), false);
+                    }
+                }
+            }
+        }
+        let h = hollow(&g, Wall::new(2).unwrap(), 1, 2);
+        // The base's top two layers are whole under the tower.
+        for z in 6..8 {
+            for y in 0..20 {
+                for x in 0..20 {
+                    assert!(h.shell.get(Cell::new(x, y, z)), "({x}, {y}, {z})");
+                }
+            }
+        }
+        // Below the lid, the base is hollow; the tower is hollow too.
+        assert!(!h.shell.get(Cell::new(10, 10, 3)));
+        assert!(!h.shell.get(Cell::new(10, 10, 11)));
+        // No part of a layer's shell hangs over the hollow.
+        for c in h.shell.cells().filter(|c| c.z > 0) {
+            let part = layer_part(&h.shell, c);
+            assert!(
+                part.iter().any(|q| h.shell.get(q.offset(0, 0, -1)))
+                    || !part.iter().any(|q| h.emptied.get(q.offset(0, 0, -1))),
+                "{c:?} hangs over the hollow"
+            );
+        }
+        assert_eq!(h.shell.count() + h.emptied.count(), g.count());
     }
 
     #[test]
