@@ -51,12 +51,19 @@ fn the_shipped_rules_are_learned_from_people_s_builds_and_credit_them() {
     // The weights are the counts the header states.
     let rs = RuleSet::parse(&shipped, Path::new("rules/default.rules")).unwrap();
     let total: f64 = rs.explicit_rules().iter().map(|r| r.weight).sum();
-    let stated = format!(
-        "# {} rules, total count {},",
-        thousands(rs.explicit_rules().len()),
-        thousands(total as usize)
-    );
-    assert!(header.iter().any(|l| l.starts_with(&stated)), "{stated}");
+    // "# N rules, total count T, counts from ...", numbers with commas.
+    let totals = header
+        .iter()
+        .find(|l| l.contains(" rules, total count "))
+        .expect("the header states the totals");
+    let number = |s: &str| -> usize { s.replace(',', "").trim().parse().unwrap() };
+    let (rules, rest) = totals[2..].split_once(" rules, total count ").unwrap();
+    let count = rest
+        .split(',')
+        .take_while(|p| !p.contains("counts"))
+        .collect::<String>();
+    assert_eq!(number(rules), rs.explicit_rules().len(), "{totals}");
+    assert_eq!(number(&count), total as usize, "{totals}");
     assert!(rs.explicit_rules().len() > 2000);
     // People's builds teach bricks, plates, slopes and inverted slopes.
     for id in ["3001", "3010", "3024", "3039", "4286", "3660a"] {
@@ -81,17 +88,4 @@ fn the_example_corpus_is_learned_whole() {
     let text = learned.to_rules_text();
     let rs = RuleSet::parse(&text, Path::new("examples.rules")).unwrap();
     assert!(rs.explicit_rules().len() > 100);
-}
-
-/// `n` with commas between thousands.
-fn thousands(n: usize) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }

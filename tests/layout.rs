@@ -339,6 +339,14 @@ fn corpus_shares(rules: &RuleSet) -> BTreeMap<u32, f64> {
     shares
 }
 
+/// The rule file `text`, its bricks only.
+fn bricks_of(text: &str) -> RuleSet {
+    RuleSet::parse(text, "r.rules".as_ref())
+        .unwrap()
+        .restricted(|p| p.spec().family() == Family::Brick)
+        .unwrap()
+}
+
 /// `text` with every weight 1: the same rules, no data.
 fn uniform(text: &str) -> String {
     text.lines()
@@ -362,13 +370,7 @@ fn uniform(text: &str) -> String {
 #[test]
 fn learned_weights_bring_the_derivation_toward_the_corpus() {
     let text = brickwright::grammar::default_rules_text();
-    let bricks = |t: &str| {
-        RuleSet::parse(t, "r.rules".as_ref())
-            .unwrap()
-            .restricted(|p| p.spec().family() == Family::Brick)
-            .unwrap()
-    };
-    let (learned, flat) = (bricks(&text), bricks(&uniform(&text)));
+    let (learned, flat) = (bricks_of(&text), bricks_of(&uniform(&text)));
     let corpus = corpus_shares(&learned);
     let seen = |s: &BTreeMap<u32, f64>| -> f64 {
         s.iter()
@@ -395,13 +397,7 @@ fn learned_weights_bring_the_derivation_toward_the_corpus() {
 #[test]
 fn a_heavy_rule_is_used_more_by_the_layout() {
     let text = brickwright::grammar::default_rules_text();
-    let bricks = |t: &str| {
-        RuleSet::parse(t, "r.rules".as_ref())
-            .unwrap()
-            .restricted(|p| p.spec().family() == Family::Brick)
-            .unwrap()
-    };
-    let plain = bricks(&text);
+    let plain = bricks_of(&text);
     let before = rule_shares("house.obj", &plain, &[1, 2]);
     let numbers = plain.numbers();
     let (n, rule) = plain
@@ -430,7 +426,7 @@ fn a_heavy_rule_is_used_more_by_the_layout() {
             }
         })
         .collect();
-    let after = rule_shares("house.obj", &bricks(&heavy), &[1, 2]);
+    let after = rule_shares("house.obj", &bricks_of(&heavy), &[1, 2]);
     let (x, y) = (before[&n], after.get(&n).copied().unwrap_or(0.0));
     eprintln!("layout: rule {n} ({rule:?}): share {x:.4} -> {y:.4}");
     // 0.0200 -> 0.0223: the layout weighs a joint by how typical it is of
