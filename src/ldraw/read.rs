@@ -49,7 +49,8 @@ const INHERIT_COLOUR: Color = Color(16);
 /// The finest vertical step, in LDU, a piece may sit at: half a plate.
 const Y_GRID_LDU: f64 = 4.0;
 
-/// `0 Author:` lines kept a section; more are ignored.
+/// `0 Author:` lines kept a section, and distinct authors a model; more
+/// are ignored.
 const MAX_AUTHORS: usize = 16;
 
 /// Characters kept of an `0 Author:` or `0 !LICENSE` line.
@@ -108,7 +109,7 @@ pub struct LdrModel {
     /// a reference to one is a part reference.
     pub packed_parts: usize,
     /// The authors its model sections name (`0 Author:` lines outside
-    /// packed part definitions), each once, in file order.
+    /// packed part definitions), each once, in file order, at most 16.
     pub authors: Vec<String>,
     /// The licence its model sections state (the first `0 !LICENSE` line
     /// outside packed part definitions), if any.
@@ -158,7 +159,7 @@ pub fn parse_ldr(text: &str, path: &Path) -> Result<LdrModel, LdrError> {
     let models = || file.sections.iter().filter(|s| !s.part);
     let mut authors: Vec<String> = Vec::new();
     for a in models().flat_map(|s| &s.authors) {
-        if !authors.contains(a) {
+        if authors.len() < MAX_AUTHORS && !authors.contains(a) {
             authors.push(a.clone());
         }
     }
