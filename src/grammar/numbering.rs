@@ -50,7 +50,7 @@ impl Numbering {
     pub(super) fn of(set: &RuleSet) -> Numbering {
         let starts: Vec<PartKind> = set.starts.iter().map(|s| s.part).collect();
         let first = starts.len() as u32;
-        let mut basic = KeyMap::default();
+        let mut basic = KeyMap::with_capacity_and_hasher(set.variants.len(), Default::default());
         for v in &set.variants {
             basic.entry(key(v)).or_insert(first + v.rule.0);
         }
