@@ -388,9 +388,18 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
         .map(|t| t.map(|p| (p - origin) / cell))
         .collect();
 
-    let grid = fill(&scaled, dims);
-    let slant = Slant::mark(&scaled, &tris, grid.dims());
-    let surface = surface_cells(&scaled, grid.dims());
+    // The three passes over the triangles are independent: they run side
+    // by side (each alone, as before, so the result is the same).
+    let d = (dims[0] as i32, dims[1] as i32, dims[2] as i32);
+    let (grid, (slant, surface)) = rayon::join(
+        || fill(&scaled, dims),
+        || {
+            rayon::join(
+                || Slant::mark(&scaled, &tris, d),
+                || surface_cells(&scaled, d),
+            )
+        },
+    );
     Ok(VoxelModel {
         grid,
         surface,
@@ -444,12 +453,19 @@ fn surface_cells(tris: &[[DVec3; 3]], dims: (i32, i32, i32)) -> VoxelGrid {
 /// can call it on prepared input.
 pub fn fill(tris: &[[DVec3; 3]], dims: [usize; 3]) -> VoxelGrid {
     let mut bits = Bits::new(dims);
-    let crossings: [Vec<Crossing>; 3] = [0, 1, 2].map(|axis| crossings(tris, dims, axis));
+    // Each axis alone, the three side by side.
+    use rayon::prelude::*;
+    let per_axis: Vec<(Vec<Crossing>, Bits)> = (0..3usize)
+        .into_par_iter()
+        .map(|axis| {
+            let list = crossings(tris, dims, axis);
+            let inside = inside_along(&list, dims, axis);
+            (list, inside)
+        })
+        .collect();
+    let (crossings, votes): (Vec<Vec<Crossing>>, Vec<Bits>) = per_axis.into_iter().unzip();
 
     // Majority vote of the three axes.
-    let votes: Vec<Bits> = (0..3)
-        .map(|axis| inside_along(&crossings[axis], dims, axis))
-        .collect();
     for (((w, a), b), c) in bits
         .words
         .iter_mut()
