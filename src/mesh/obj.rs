@@ -8,6 +8,7 @@
 //! those are reported as `file.obj:17: ...`. Only what gets past that check
 //! is handed to `tobj`.
 
+use std::borrow::Cow;
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -261,12 +262,14 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
         }
     };
     // Positive face indices may refer forward, so count all vertices first.
-    let total = logical_lines(text)
-        .filter(|(_, l)| l.split_whitespace().next() == Some("v"))
-        .count();
-    let total_vt = logical_lines(text)
-        .filter(|(_, l)| l.split_whitespace().next() == Some("vt"))
-        .count();
+    let (mut total, mut total_vt) = (0usize, 0usize);
+    for (_, l) in logical_lines(text) {
+        match l.split_whitespace().next() {
+            Some("v") => total += 1,
+            Some("vt") => total_vt += 1,
+            _ => {}
+        }
+    }
     let mut seen = 0usize;
     let mut seen_vt = 0usize;
     // The text handed on: comments gone, continued lines joined, and face
@@ -377,11 +380,19 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
 }
 
 /// The file's statements with their 1-based starting line numbers: comments
-/// stripped, lines ending in `\` joined with the next.
-fn logical_lines(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
+/// stripped, lines ending in `\` joined with the next (a line needing
+/// neither is handed on as it is, not copied).
+fn logical_lines(text: &str) -> impl Iterator<Item = (usize, Cow<'_, str>)> + '_ {
     let mut lines = text.lines().enumerate().peekable();
     std::iter::from_fn(move || {
         let (i, first) = lines.next()?;
+        if !first.ends_with('\\') {
+            let kept = match first.find('#') {
+                Some(hash) => &first[..hash],
+                None => first,
+            };
+            return Some((i + 1, Cow::Borrowed(kept)));
+        }
         let mut joined = String::from(first);
         while joined.ends_with('\\') {
             joined.pop();
@@ -396,7 +407,7 @@ fn logical_lines(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
         if let Some(hash) = joined.find('#') {
             joined.truncate(hash);
         }
-        Some((i + 1, joined))
+        Some((i + 1, Cow::Owned(joined)))
     })
 }
 
