@@ -120,18 +120,17 @@ fn layer_part(g: &VoxelGrid, start: Cell) -> Vec<Cell> {
     if !g.in_bounds(start) || !g.get(start) {
         return Vec::new();
     }
-    let (nx, ny, _) = g.dims();
-    let mut seen = vec![false; (nx * ny) as usize];
-    let at = |c: Cell| (c.y * nx + c.x) as usize;
-    seen[at(start)] = true;
+    // Cells seen, as many as the part has (not the layer's area: a layer
+    // may hold many small parts).
+    let mut seen: crate::keyhash::KeySet<(i32, i32)> = crate::keyhash::KeySet::default();
+    seen.insert((start.x, start.y));
     let mut stack = vec![start];
     let mut out = Vec::new();
     while let Some(c) = stack.pop() {
         out.push(c);
         for (dx, dy) in SIDES {
             let d = c.offset(dx, dy, 0);
-            if g.in_bounds(d) && !seen[at(d)] && g.get(d) {
-                seen[at(d)] = true;
+            if g.in_bounds(d) && g.get(d) && seen.insert((d.x, d.y)) {
                 stack.push(d);
             }
         }
