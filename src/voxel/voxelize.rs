@@ -74,6 +74,7 @@
 use std::collections::HashSet;
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use super::VoxelGrid;
 use crate::geom::Cell;
@@ -454,7 +455,6 @@ fn surface_cells(tris: &[[DVec3; 3]], dims: (i32, i32, i32)) -> VoxelGrid {
 pub fn fill(tris: &[[DVec3; 3]], dims: [usize; 3]) -> VoxelGrid {
     let mut bits = Bits::new(dims);
     // Each axis alone, the three side by side.
-    use rayon::prelude::*;
     let per_axis: Vec<(Vec<Crossing>, Bits)> = (0..3usize)
         .into_par_iter()
         .map(|axis| {
