@@ -81,8 +81,14 @@ pub struct SearchOptions {
     pub method: Method,
     /// Backward tracing: the branching factor `b`, from its first value
     /// at the root to its second as the voxels run out (paper: 10-30
-    /// rising to 100-200). Default (20, 150).
+    /// rising to 100-200): how many rules that match a node are drawn
+    /// there. Default (20, 150).
     pub branching: (u32, u32),
+    /// Backward tracing: a pass of the tree that makes this many nodes
+    /// (times the Luby sequence's next term: 1, 1, 2, 1, 1, 2, 4, ...)
+    /// without an answer starts again from the root with new draws; 0
+    /// never. Default 300.
+    pub restart: u64,
     /// Backward tracing: the most tree nodes before it gives up. Default
     /// 1,000,000.
     pub node_budget: u64,
@@ -113,6 +119,7 @@ impl Default for SearchOptions {
             hollow: None,
             method: Method::Layout,
             branching: (20, 150),
+            restart: 300,
             node_budget: 1_000_000,
             cut: true,
             cap_stairs: true,
@@ -154,6 +161,12 @@ impl SearchOptions {
     /// Sets the backward tracing's branching factor, first and last.
     pub fn with_branching(mut self, first: u32, last: u32) -> Self {
         self.branching = (first, last);
+        self
+    }
+
+    /// Sets the backward tracing's restart length (0: never restart).
+    pub fn with_restart(mut self, nodes: u64) -> Self {
+        self.restart = nodes;
         self
     }
 

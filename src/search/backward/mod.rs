@@ -21,6 +21,7 @@
 //! splits, no pieces outside the voxels; every piece fills voxels of the
 //! model only, as in the paper.
 
+mod draw;
 mod fit;
 mod trace;
 
@@ -125,6 +126,7 @@ pub(super) fn build(
         b_max: opts.branching.1.max(opts.branching.0),
         complex_every: opts.complex_every,
         node_budget: opts.node_budget,
+        restart: opts.restart,
         deadline: started + opts.time_budget,
     };
     // Parts at least a brick high (a course: 1 layer for bricks, more for
@@ -155,7 +157,8 @@ pub(super) fn build(
             &below_pieces,
             order.is_empty(),
         );
-        let part = t.run(&mut rng, &mut count).map_err(|stop| SearchError::Backward {
+        let part = t.run(&mut rng, &mut count);
+        let part = part.map_err(|stop| SearchError::Backward {
             why: match stop {
                 Stop::Exhausted => format!(
                     "every branch of the tree was tried: these rules cannot build part {} of {} (layers {lo} to {})",

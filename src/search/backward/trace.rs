@@ -30,17 +30,19 @@
 
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
-use std::hash::{Hash, Hasher};
+use std::rc::Rc;
 use std::time::Instant;
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+use super::draw::{Drawn, Draws};
 use super::fit::placeable;
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
-use crate::geom::{Body, Cell, Rot};
-use crate::grammar::{Dir, Link, RuleRef, RuleSet};
+use crate::geom::{Body, Cell, CellBox, Rot};
+use crate::grammar::{Dir, Link, RuleRef, RuleSet, Variant};
+use crate::keyhash::{KeyMap, KeySet};
 use crate::search::rulebook::RuleBook;
 use crate::search::{Anchor, Removal};
 use crate::voxel::VoxelGrid;
@@ -52,6 +54,9 @@ pub(super) struct Tuning {
     pub b_max: u32,
     pub complex_every: u32,
     pub node_budget: u64,
+    /// Nodes a pass makes (times the Luby sequence's term) before the
+    /// tree is searched again from its root; 0 never.
+    pub restart: u64,
     pub deadline: Instant,
 }
 
@@ -75,6 +80,61 @@ pub(super) enum Stop {
     Time,
 }
 
+/// A piece's shape: its part and turn.
+type Shape = (PartKind, Rot);
+
+/// Draws in a row that match nowhere before a node lists the rules that
+/// match it ([`Trace::draw_next`]).
+const MISSES: u32 = 64;
+
+/// The rule variants by the shape of their new piece and of their anchor.
+pub(super) struct VariantIndex {
+    by_added: Vec<((PartKind, Rot), Vec<u32>)>,
+    by_anchor: Vec<((PartKind, Rot), Vec<u32>)>,
+}
+
+impl VariantIndex {
+    pub fn new(rules: &RuleSet) -> VariantIndex {
+        let group = |key: &dyn Fn(&Variant) -> (PartKind, Rot)| {
+            let mut m: std::collections::BTreeMap<(PartKind, Rot), Vec<u32>> = Default::default();
+            for (i, v) in rules.variants().iter().enumerate() {
+                if v.weight > 0.0 {
+                    m.entry(key(v)).or_default().push(i as u32);
+                }
+            }
+            m.into_iter().collect()
+        };
+        VariantIndex {
+            by_added: group(&|v| (v.added, v.added_rot)),
+            by_anchor: group(&|v| (v.anchor, v.anchor_rot)),
+        }
+    }
+}
+
+/// How a pass ends (when it does not stop the trace).
+enum Pass {
+    /// With a derivation.
+    Found(Vec<Removal>),
+    /// With no child left at the root.
+    Ended,
+    /// At its share of nodes: the next pass starts again at the root.
+    CutShort,
+}
+
+/// The `i`-th term (from 1) of the Luby sequence: 1, 1, 2, 1, 1, 2, 4, 1,
+/// 1, 2, 1, 1, 2, 4, 8, ...
+fn luby(i: u32) -> u64 {
+    let mut i = u64::from(i.max(1));
+    loop {
+        // The smallest k with 2^k - 1 >= i.
+        let k = 64 - i.leading_zeros();
+        if i == (1u64 << k) - 1 {
+            return 1u64 << (k - 1);
+        }
+        i -= (1u64 << (k - 1)) - 1;
+    }
+}
+
 /// A node's local change: the pieces a reverse match took away (each with
 /// the piece it joins), and the pieces it left matched.
 #[derive(Debug, Clone)]
@@ -91,19 +151,34 @@ struct Frame {
     /// Rules to try, in order: `Ok(variant)` a basic rule variant,
     /// `Err(variant)` a complex one.
     tries: Vec<Result<u32, u32>>,
+    /// The first match of each basic variant in `tries`, found when it
+    /// was drawn.
+    first: Vec<Option<(Change, usize)>>,
     next: usize,
     /// Where the scan of the rule being tried goes on: each match of a
     /// rule, in scan order, is a child.
     cursor: usize,
     /// (B, A) pairs already tried here.
-    tried: HashSet<(Placement, Placement)>,
+    tried: KeySet<(Placement, Placement)>,
     /// Where each shape of new piece may be taken away at this node.
-    spots: HashMap<(PartKind, Rot), Vec<Placement>>,
+    spots: RefCell<KeyMap<Shape, Rc<[Placement]>>>,
+    /// The matched pieces something left touches (see [`Trace::frontier`]).
+    frontier: Vec<Placement>,
     /// The change that made this node from its parent.
     change: Option<Change>,
     /// Whether every rule that could match is among `tries` (`b` was no
     /// smaller than their number).
     complete: bool,
+    /// How many basic variants the node may try: `b`.
+    b: usize,
+    /// The variants drawn here so far, and draws whose groups were shut.
+    drawn: Vec<Drawn>,
+    shut: Vec<Drawn>,
+    /// Draws in a row that matched nowhere.
+    misses: u32,
+    /// Once drawing misses too often: every variant not drawn yet that
+    /// matches here, in the order of a draw from their weights.
+    listed: Option<std::collections::VecDeque<u32>>,
     /// Whether every child's subtree was searched whole (each of its nodes
     /// `complete`): only a node complete and whole has failed for good.
     whole: bool,
@@ -122,10 +197,17 @@ pub(super) struct Trace<'a> {
     /// Cells of pending pieces.
     held: VoxelGrid,
     pending: Vec<Placement>,
+    pending_set: KeySet<Placement>,
     /// Pieces taken away, in backward order, with the rule and anchor.
     taken: Vec<Placement>,
     /// The pieces of the parts below, built before this part.
     below_pieces: &'a [Placement],
+    /// The cells of the parts below.
+    below: &'a VoxelGrid,
+    /// The pieces below that this part's cells sit on: matched from the
+    /// start, anchors a match may join (never taken away).
+    ground: Vec<Placement>,
+    ground_set: KeySet<Placement>,
     /// Whether this is the first part (its last piece needs a starting
     /// rule; the others' a rule joining it to the parts below).
     first: bool,
@@ -145,12 +227,30 @@ pub(super) struct Trace<'a> {
     last_pass_whole: bool,
     /// For each applied change, which of its taken pieces were pending.
     were_log: Vec<Vec<bool>>,
+    /// Each free cell's last piece found by [`Trace::coverable`].
+    witness: RefCell<HashMap<Cell, Body>>,
+    /// The rules' draws.
+    draws: RefCell<Draws>,
+    /// The rules by shape.
+    index: VariantIndex,
 }
 
+/// A piece's share of a state's hash (`salt` 1: matched, 2: taken).
 fn piece_hash(p: &Placement, salt: u64) -> u64 {
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    (p, salt).hash(&mut h);
-    h.finish()
+    let o = p.origin;
+    let key = u64::from(p.part.0)
+        | u64::from(o.x as u16) << 16
+        | u64::from(o.y as u16) << 32
+        | u64::from(o.z as u16) << 48;
+    mix(key ^ mix((p.rot as u64) << 2 | salt))
+}
+
+/// SplitMix64's finaliser: every bit of the key stirs every bit out.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
 }
 
 impl<'a> Trace<'a> {
@@ -172,6 +272,16 @@ impl<'a> Trace<'a> {
         for c in cells.cells() {
             built.set(c, true);
         }
+        let layer = rules.layer_ldu();
+        let ground: Vec<Placement> = below_pieces
+            .iter()
+            .filter(|p| {
+                let top = p.body(layer).over_studs();
+                let on = top.cells().any(|c| cells.in_bounds(c) && cells.get(c));
+                on
+            })
+            .copied()
+            .collect();
         Trace {
             rules,
             book,
@@ -182,8 +292,12 @@ impl<'a> Trace<'a> {
             total: n,
             held: VoxelGrid::new(nx, ny, nz),
             pending: Vec::new(),
+            pending_set: KeySet::default(),
             taken: Vec::new(),
             below_pieces,
+            below,
+            ground_set: ground.iter().copied().collect(),
+            ground,
             first,
             built: RefCell::new(built),
             shapes: coverers(rules),
@@ -192,6 +306,9 @@ impl<'a> Trace<'a> {
             failed: HashSet::new(),
             last_pass_whole: false,
             were_log: Vec::new(),
+            witness: RefCell::new(HashMap::new()),
+            draws: RefCell::new(Draws::new(rules.variants())),
+            index: VariantIndex::new(rules),
         }
     }
 
@@ -203,6 +320,14 @@ impl<'a> Trace<'a> {
     /// searched again (what failed for good is remembered, so a pass
     /// repeats little). Only a pass in which every node tried every rule
     /// proves the rules cannot build the part.
+    ///
+    /// A pass also ends when it has made `restart` nodes times the next
+    /// term of the Luby sequence (1, 1, 2, 1, 1, 2, 4, ...) without an
+    /// answer: the tree is searched again from its root with new draws.
+    /// A depth-first search whose draws fix a wrong piece near the root
+    /// can spend its whole budget under it; the draws of another pass
+    /// seldom make the same mistake, and the growing terms leave room for
+    /// a pass as long as the part needs.
     pub fn run(
         &mut self,
         rng: &mut ChaCha8Rng,
@@ -212,24 +337,33 @@ impl<'a> Trace<'a> {
             return Ok(vec![r]);
         }
         let all = self.rules.variants().len() as u32;
-        loop {
-            if let Some(d) = self.pass(rng, count)? {
-                return Ok(d);
+        for i in 1u32.. {
+            let limit = match self.tuning.restart {
+                0 => u64::MAX,
+                r => count.nodes.saturating_add(r.saturating_mul(luby(i))),
+            };
+            match self.pass(rng, count, limit)? {
+                Pass::Found(d) => return Ok(d),
+                Pass::CutShort => continue,
+                Pass::Ended => {}
             }
             if self.last_pass_whole || self.tuning.b_min.max(1) * self.widen > all {
                 return Err(Stop::Exhausted);
             }
             self.widen *= 2;
         }
+        unreachable!("a pass ends the loop")
     }
 
-    /// One pass of the depth-first tree: a derivation, or `None` when the
-    /// root has no child left (`last_pass_whole` says whether for good).
+    /// One pass of the depth-first tree, until it finds a derivation, the
+    /// root has no child left (`last_pass_whole` says whether for good),
+    /// or the count of nodes reaches `limit`.
     fn pass(
         &mut self,
         rng: &mut ChaCha8Rng,
         count: &mut Counters,
-    ) -> Result<Option<Vec<Removal>>, Stop> {
+        limit: u64,
+    ) -> Result<Pass, Stop> {
         let mut log: Vec<Change> = Vec::new();
         // The nodes whose subtrees this pass searched to the end, by state.
         let mut exhausted: HashSet<u64> = HashSet::new();
@@ -237,22 +371,37 @@ impl<'a> Trace<'a> {
         let mut stack = vec![root];
         loop {
             if let Some(last) = self.finished() {
-                return Ok(Some(self.derivation(&log, last)));
+                return Ok(Pass::Found(self.derivation(&log, last)));
             }
             if count.nodes >= self.tuning.node_budget {
                 return Err(Stop::Nodes);
+            }
+            if count.nodes >= limit {
+                // Back to the root, undoing every change on the way.
+                while let Some(f) = stack.pop() {
+                    if let Some(c) = f.change {
+                        self.undo(&c);
+                    }
+                }
+                return Ok(Pass::CutShort);
             }
             if count.nodes.is_multiple_of(64) && Instant::now() >= self.tuning.deadline {
                 return Err(Stop::Time);
             }
             let Some(top) = stack.last_mut() else {
-                return Ok(None);
+                return Ok(Pass::Ended);
             };
             let mut child = None;
-            while top.next < top.tries.len() && child.is_none() {
+            while child.is_none() {
+                if top.next == top.tries.len() && !self.draw_next(top, rng) {
+                    break;
+                }
                 let t = top.tries[top.next];
                 let found = match t {
-                    Ok(v) => self.match_basic(v, top, top.cursor),
+                    Ok(v) => match top.first[top.next].take() {
+                        Some(m) if top.cursor == 0 => Some(m),
+                        _ => self.match_basic(v, top, top.cursor),
+                    },
                     Err(v) => {
                         if top.cursor == 0 {
                             count.complex_tried += 1;
@@ -323,68 +472,187 @@ impl<'a> Trace<'a> {
         }
     }
 
-    /// A node's rules to try: `b` basic rule variants drawn from the
-    /// weights, a complex one first every `complex_every` nodes.
+    /// A node: its `b` (its rules to try are drawn as they are needed,
+    /// [`Trace::draw_next`]), and a complex rule to try first every
+    /// `complex_every` nodes.
     fn frame(&self, rng: &mut ChaCha8Rng, count: &Counters, change: Option<Change>) -> Frame {
         let t = &self.tuning;
         let done = 1.0 - self.left_count as f64 / self.total.max(1) as f64;
         let b = t.b_min as f64 + (t.b_max.saturating_sub(t.b_min)) as f64 * done;
-        let b = (b.round() as usize).saturating_mul(self.widen as usize);
-        // Only rules whose new piece fits somewhere it may go can match.
-        let mut shapes: Vec<(PartKind, Rot)> = self
-            .rules
-            .variants()
-            .iter()
-            .flat_map(|v| [(v.added, v.added_rot), (v.anchor, v.anchor_rot)])
-            .chain(
-                self.rules
-                    .complex_variants()
-                    .iter()
-                    .filter_map(|c| c.v.first().map(|n| (n.piece.part, n.piece.rot))),
-            )
-            .collect();
-        shapes.sort();
-        shapes.dedup();
-        let spots: HashMap<(PartKind, Rot), Vec<Placement>> = shapes
-            .into_iter()
-            .map(|(p, r)| ((p, r), self.spots(p, r)))
-            .filter(|(_, s)| !s.is_empty())
-            .collect();
-        let fits = |v: &crate::grammar::Variant| {
-            spots.contains_key(&(v.added, v.added_rot))
-                || spots.contains_key(&(v.anchor, v.anchor_rot))
+        let b = (b.round() as usize)
+            .saturating_mul(self.widen as usize)
+            .max(1);
+        let mut frame = Frame {
+            tries: Vec::new(),
+            first: Vec::new(),
+            next: 0,
+            cursor: 0,
+            tried: KeySet::default(),
+            spots: RefCell::new(KeyMap::default()),
+            frontier: self.frontier(),
+            change,
+            complete: false,
+            whole: true,
+            b,
+            drawn: Vec::new(),
+            shut: Vec::new(),
+            misses: 0,
+            listed: None,
         };
-        // Weighted sampling without replacement: the largest u^(1/w).
-        let mut keyed: Vec<(f64, u32)> = self
-            .rules
-            .variants()
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.weight > 0.0 && fits(v))
-            .map(|(i, v)| {
-                let u: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
-                (u.ln() / v.weight, i as u32)
-            })
-            .collect();
-        keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let complete = keyed.len() <= b.max(1);
-        keyed.truncate(b.max(1));
-        let mut tries: Vec<Result<u32, u32>> = keyed.into_iter().map(|(_, i)| Ok(i)).collect();
         let nc = self.rules.complex_variants().len();
         if t.complex_every > 0 && nc > 0 && count.nodes.is_multiple_of(u64::from(t.complex_every)) {
             let pick = rng.gen_range(0..nc) as u32;
-            tries.insert(0, Err(pick));
+            frame.tries.insert(0, Err(pick));
+            frame.first.insert(0, None);
         }
-        Frame {
-            tries,
-            next: 0,
-            cursor: 0,
-            tried: HashSet::new(),
-            spots,
-            change,
-            complete,
-            whole: true,
+        frame
+    }
+
+    /// Draws the node's next rule to try: a basic rule variant that
+    /// matches here, drawn from the weights among those not drawn yet
+    /// (without replacement; the rules drawn before at this node stay
+    /// out). `false` when the node has tried `b` of them, or every one
+    /// that matches (then it is `complete`).
+    ///
+    /// Most draws match at once. Where few rules match (near the end of a
+    /// part, where a last piece can only join the parts below), drawing
+    /// would go through nearly every rule: after [`MISSES`] misses in a
+    /// row the node finds every variant that matches instead, going over
+    /// its places rather than its rules, and draws among those. Both
+    /// give the same order of rules, in law: each next rule is drawn in
+    /// proportion to its weight among the ones left that match.
+    fn draw_next(&self, frame: &mut Frame, rng: &mut ChaCha8Rng) -> bool {
+        let basics = frame.tries.iter().filter(|t| t.is_ok()).count();
+        if basics >= frame.b {
+            return false;
         }
+        if let Some(list) = &mut frame.listed {
+            let Some(v) = list.pop_front() else {
+                frame.complete = true;
+                return false;
+            };
+            frame.tries.push(Ok(v));
+            frame.first.push(None);
+            return true;
+        }
+        let mut draws = self.draws.borrow_mut();
+        draws.reopen(&frame.drawn, &frame.shut);
+        let mut found = false;
+        while !found {
+            let Some(d) = draws.draw(rng) else {
+                frame.complete = true;
+                break;
+            };
+            frame.drawn.push(d);
+            let var = &self.rules.variants()[d.variant as usize];
+            if self.spots_at(frame, (var.added, var.added_rot)).is_empty()
+                && self
+                    .spots_at(frame, (var.anchor, var.anchor_rot))
+                    .is_empty()
+            {
+                draws.shut(d);
+                frame.shut.push(d);
+                continue;
+            }
+            if let Some(m) = self.match_basic(d.variant, frame, 0) {
+                frame.tries.push(Ok(d.variant));
+                frame.first.push(Some(m));
+                frame.misses = 0;
+                found = true;
+            } else {
+                frame.misses += 1;
+                if frame.misses >= MISSES {
+                    break;
+                }
+            }
+        }
+        draws.close();
+        drop(draws);
+        if !found && !frame.complete {
+            let drawn: KeySet<u32> = frame.drawn.iter().map(|d| d.variant).collect();
+            let mut keyed: Vec<(f64, u32)> = self
+                .matching(frame, &drawn)
+                .into_iter()
+                .map(|v| {
+                    let w = self.rules.variants()[v as usize].weight;
+                    let u: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
+                    (u.ln() / w, v)
+                })
+                .collect();
+            keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            frame.listed = Some(keyed.into_iter().map(|(_, v)| v).collect());
+            return self.draw_next(frame, rng);
+        }
+        found
+    }
+
+    /// Every basic variant not in `drawn` that matches somewhere at
+    /// `node`, in the rule file's order: found from the places (each
+    /// place a new piece may be taken away, with each variant of its
+    /// shape; each free place an anchor may stay, with each variant of
+    /// its shape), not by trying each rule.
+    fn matching(&self, node: &Frame, drawn: &KeySet<u32>) -> Vec<u32> {
+        let vars = self.rules.variants();
+        let mut hit = vec![false; vars.len()];
+        for (shape, list) in &self.index.by_added {
+            let places = self.spots_at(node, *shape);
+            for &v in list {
+                if hit[v as usize] || drawn.contains(&v) {
+                    continue;
+                }
+                let var = &vars[v as usize];
+                hit[v as usize] = places
+                    .iter()
+                    .any(|b| self.match_at(var, *b, true).is_some());
+            }
+        }
+        for (shape, list) in &self.index.by_anchor {
+            let places = self.spots_at(node, *shape);
+            for &v in list {
+                if hit[v as usize] || drawn.contains(&v) {
+                    continue;
+                }
+                let var = &vars[v as usize];
+                let (ox, oy, oz) = var.offset;
+                hit[v as usize] = places.iter().any(|a| {
+                    let b = Placement::new(var.added, a.origin.offset(ox, oy, oz), var.added_rot);
+                    self.match_at(var, b, false).is_some()
+                });
+            }
+        }
+        (0..vars.len() as u32)
+            .filter(|&v| hit[v as usize])
+            .collect()
+    }
+
+    /// Where a piece of `shape` may be taken away at `node` (or stay, as
+    /// an anchor): [`Trace::spots`], found once a node.
+    fn spots_at(&self, node: &Frame, shape: (PartKind, Rot)) -> Rc<[Placement]> {
+        if let Some(s) = node.spots.borrow().get(&shape) {
+            return Rc::clone(s);
+        }
+        let s: Rc<[Placement]> = self.spots(shape.0, shape.1, &node.frontier).into();
+        node.spots.borrow_mut().insert(shape, Rc::clone(&s));
+        s
+    }
+
+    /// The matched pieces (and the pieces below the part) that something
+    /// left touches above or below: where a match may join them.
+    fn frontier(&self) -> Vec<Placement> {
+        let near = |bx: CellBox| {
+            bx.cells()
+                .any(|d| self.left.in_bounds(d) && self.left.get(d))
+        };
+        self.pending
+            .iter()
+            .chain(&self.taken)
+            .chain(&self.ground)
+            .filter(|m| {
+                let b = self.body(m);
+                near(b.over_studs()) || near(b.under_tubes())
+            })
+            .copied()
+            .collect()
     }
 
     fn body(&self, p: &Placement) -> Body {
@@ -393,26 +661,35 @@ impl<'a> Trace<'a> {
 
     /// Whether every cell of `b` is left and not held by a pending piece.
     fn free(&self, b: &Body) -> bool {
-        b.cells()
-            .all(|c| self.left.in_bounds(c) && self.left.get(c) && !self.held.get(c))
+        b.boxes().iter().all(|bx| {
+            (0..bx.sz).all(|dz| {
+                (0..bx.sy).all(|dy| {
+                    (0..bx.sx).all(|dx| {
+                        let c = bx.min.offset(dx, dy, dz);
+                        self.left.get(c) && !self.held.get(c)
+                    })
+                })
+            })
+        })
     }
 
     fn is_pending(&self, p: &Placement) -> bool {
-        self.pending.contains(p)
+        self.pending_set.contains(p)
     }
 
     /// Where a piece of `part` turned `rot` may be taken away: the pending
     /// pieces of that shape, and free places stud-connected to a matched
     /// piece (anywhere free for the first match). Sorted bottom to top.
-    fn spots(&self, part: PartKind, rot: Rot) -> Vec<Placement> {
+    fn spots(&self, part: PartKind, rot: Rot, frontier: &[Placement]) -> Vec<Placement> {
         let mut out: Vec<Placement> = self
             .pending
             .iter()
+            .chain(&self.ground)
             .filter(|p| p.part == part && p.rot == rot)
             .copied()
             .collect();
-        let probe = Placement::new(part, Cell::new(0, 0, 0), rot);
-        let shape = self.body(&probe).bbox;
+        let probe = self.body(&Placement::new(part, Cell::new(0, 0, 0), rot));
+        let shape = probe.bbox;
         if self.pending.is_empty() && self.taken.is_empty() {
             let (nx, ny, nz) = self.left.dims();
             for z in 0..nz {
@@ -426,21 +703,16 @@ impl<'a> Trace<'a> {
                 }
             }
         } else {
-            let mut seen: HashSet<Cell> = HashSet::new();
-            for m in self.pending.iter().chain(&self.taken) {
+            for m in frontier {
                 let mb = self.body(m);
                 let bb = mb.bbox;
                 for z in [bb.min.z + bb.sz, bb.min.z - shape.sz] {
                     for y in bb.min.y - shape.sy + 1..bb.min.y + bb.sy {
                         for x in bb.min.x - shape.sx + 1..bb.min.x + bb.sx {
                             let at = Cell::new(x, y, z);
-                            if !seen.insert(at) {
-                                continue;
-                            }
-                            let p = Placement::new(part, at, rot);
-                            let b = self.body(&p);
-                            if self.free(&b) && (mb.holds(&b) || b.holds(&mb)) {
-                                out.push(p);
+                            let b = probe.moved(at.x, at.y, at.z);
+                            if (mb.holds(&b) || b.holds(&mb)) && self.free(&b) {
+                                out.push(Placement::new(part, at, rot));
                             }
                         }
                     }
@@ -469,65 +741,108 @@ impl<'a> Trace<'a> {
         ok
     }
 
-    /// The first match of basic variant `v` in its scan direction.
+    /// The first match of basic variant `v` in its scan direction, from
+    /// the `from`-th place the scan looks at.
     fn match_basic(&self, v: u32, node: &Frame, from: usize) -> Option<(Change, usize)> {
         let var = self.rules.variants()[v as usize];
         let (ox, oy, oz) = var.offset;
         // The new piece where it joins what is matched, or where its
-        // anchor does.
-        let mut spots: Vec<Placement> = node
-            .spots
-            .get(&(var.added, var.added_rot))
-            .into_iter()
-            .flatten()
-            .copied()
-            .chain(
-                node.spots
-                    .get(&(var.anchor, var.anchor_rot))
-                    .into_iter()
-                    .flatten()
-                    .map(|a| Placement::new(var.added, a.origin.offset(ox, oy, oz), var.added_rot)),
-            )
-            .collect();
-        spots.sort_by_key(|p| (p.origin.z, p.origin.y, p.origin.x));
-        spots.dedup();
+        // anchor does: the two lists of places merged in scan order (a
+        // `down` rule from the bottom up, an `up` rule from the top down).
+        let bs = self.spots_at(node, (var.added, var.added_rot));
+        let anchors = self.spots_at(node, (var.anchor, var.anchor_rot));
+        let up = var.dir == Dir::Up;
+        let (n, m) = (bs.len(), anchors.len());
+        let nth_b = |i: usize| if up { bs[n - 1 - i] } else { bs[i] };
+        let nth_a = |j: usize| {
+            let a = if up { anchors[m - 1 - j] } else { anchors[j] };
+            Placement::new(var.added, a.origin.offset(ox, oy, oz), var.added_rot)
+        };
+        let key = |p: &Placement| (p.origin.z, p.origin.y, p.origin.x);
+        let (mut i, mut j, mut k) = (0usize, 0usize, 0usize);
+        let mut last: Option<Placement> = None;
         let tried = &node.tried;
-        let n = spots.len();
-        for k in from..n {
-            let b = match var.dir {
-                Dir::Up => &spots[n - 1 - k],
-                Dir::Down => &spots[k],
+        loop {
+            // `of_b`: the place comes from the new piece's list (so it is
+            // free, pending or below), else from the anchor's.
+            let (b, of_b) = match (i < n, j < m) {
+                (false, false) => return None,
+                (true, false) => {
+                    i += 1;
+                    (nth_b(i - 1), true)
+                }
+                (false, true) => {
+                    j += 1;
+                    (nth_a(j - 1), false)
+                }
+                (true, true) => {
+                    let (x, y) = (nth_b(i), nth_a(j));
+                    let x_first = if up {
+                        key(&x) >= key(&y)
+                    } else {
+                        key(&x) <= key(&y)
+                    };
+                    if x_first {
+                        i += 1;
+                        (x, true)
+                    } else {
+                        j += 1;
+                        (y, false)
+                    }
+                }
             };
+            // A place in both lists is looked at once.
+            if last == Some(b) {
+                continue;
+            }
+            last = Some(b);
+            k += 1;
+            if k - 1 < from {
+                continue;
+            }
             let at = b.origin.offset(-ox, -oy, -oz);
             let a = Placement::new(var.anchor, at, var.anchor_rot);
-            if tried.contains(&(*b, a)) {
+            if tried.contains(&(b, a)) {
                 continue;
             }
-            let bb = self.body(b);
-            let ab = self.body(&a);
-            let a_pending = self.is_pending(&a);
-            if !a_pending && !self.free(&ab) {
-                continue;
+            if let Some(c) = self.match_at(&var, b, of_b) {
+                return Some((c, k - 1));
             }
-            if !self.is_pending(b) && !self.free(&bb) {
-                continue;
-            }
-            // The rule's joint, as the grid has it.
-            let joined = match var.dir {
-                Dir::Up => ab.holds(&bb),
-                Dir::Down => bb.holds(&ab),
-            };
-            if !joined || !self.can_place(&bb, &[], var.dir == Dir::Up) {
-                continue;
-            }
-            let c = Change {
-                rule: RuleRef::Basic(var.rule),
-                taken: vec![(*b, a)],
-                new_pending: if a_pending { vec![] } else { vec![a] },
-            };
-            return Some((c, k));
         }
-        None
+    }
+
+    /// Whether variant `var` matches with its new piece at `b` (a place
+    /// from the new piece's list of places if `of_b`, else one its anchor
+    /// makes from the anchor's list): its change.
+    fn match_at(&self, var: &Variant, b: Placement, of_b: bool) -> Option<Change> {
+        let (ox, oy, oz) = var.offset;
+        let up = var.dir == Dir::Up;
+        let a = Placement::new(var.anchor, b.origin.offset(-ox, -oy, -oz), var.anchor_rot);
+        let bb = self.body(&b);
+        let ab = self.body(&a);
+        // The rule's joint, as the grid has it.
+        let joined = if up { ab.holds(&bb) } else { bb.holds(&ab) };
+        if !joined {
+            return None;
+        }
+        // The new piece free or matched (a place from its own list is
+        // one of those, or a piece below); the anchor free, matched or
+        // below (one from its list is).
+        let a_pending = self.is_pending(&a) || self.ground_set.contains(&a);
+        let b_ok = if of_b {
+            !self.ground_set.contains(&b)
+        } else {
+            self.is_pending(&b) || self.free(&bb)
+        };
+        let a_ok = a_pending || !of_b || self.free(&ab);
+        if !b_ok || !a_ok || !self.can_place(&bb, &[], up) {
+            return None;
+        }
+        Some(Change {
+            rule: RuleRef::Basic(var.rule),
+            taken: vec![(b, a)],
+            new_pending: if a_pending { vec![] } else { vec![a] },
+        })
     }
 
     /// The first match of complex variant `v`: its new pieces free or
@@ -535,7 +850,7 @@ impl<'a> Trace<'a> {
     fn match_complex(&self, v: u32, node: &Frame, from: usize) -> Option<(Change, usize)> {
         let var = &self.rules.complex_variants()[v as usize];
         let first = var.v.first()?;
-        let spots = node.spots.get(&(first.piece.part, first.piece.rot))?;
+        let spots = self.spots_at(node, (first.piece.part, first.piece.rot));
         for (k, s) in spots.iter().rev().enumerate().skip(from) {
             let at = first.piece.at;
             let origin = s.origin.offset(-at.x, -at.y, -at.z);
@@ -556,10 +871,15 @@ impl<'a> Trace<'a> {
             let matched = self.pending.is_empty() && self.taken.is_empty()
                 || news.iter().chain(&olds).any(|p| {
                     self.is_pending(p)
-                        || self.pending.iter().chain(&self.taken).any(|m| {
-                            let (a, b) = (self.body(m), self.body(p));
-                            a.holds(&b) || b.holds(&a)
-                        })
+                        || self
+                            .pending
+                            .iter()
+                            .chain(&self.taken)
+                            .chain(&self.ground)
+                            .any(|m| {
+                                let (a, b) = (self.body(m), self.body(p));
+                                a.holds(&b) || b.holds(&a)
+                            })
                 });
             if !matched {
                 continue;
@@ -611,6 +931,7 @@ impl<'a> Trace<'a> {
             let b = self.body(a);
             self.held.set_body(&b, true);
             self.pending.push(*a);
+            self.pending_set.insert(*a);
             self.hash ^= piece_hash(a, 1);
         }
         for (p, _) in &c_taken {
@@ -618,6 +939,7 @@ impl<'a> Trace<'a> {
             let was = self.is_pending(p);
             if was {
                 self.pending.retain(|q| q != p);
+                self.pending_set.remove(p);
                 self.held.set_body(&b, false);
                 self.hash ^= piece_hash(p, 1);
             }
@@ -643,6 +965,7 @@ impl<'a> Trace<'a> {
             self.left_count += b.volume() as usize;
             if was {
                 self.pending.push(*p);
+                self.pending_set.insert(*p);
                 self.held.set_body(&b, true);
                 self.hash ^= piece_hash(p, 1);
             }
@@ -651,6 +974,7 @@ impl<'a> Trace<'a> {
             let b = self.body(a);
             self.held.set_body(&b, false);
             self.pending.retain(|q| q != a);
+            self.pending_set.remove(a);
             self.hash ^= piece_hash(a, 1);
         }
     }
@@ -665,6 +989,18 @@ impl<'a> Trace<'a> {
         let Some(start) = self.left.cells().next() else {
             return true;
         };
+        // Above the first part, every cell must reach the parts below.
+        let mut stack: Vec<Cell> = if self.first {
+            vec![start]
+        } else {
+            self.left
+                .cells()
+                .filter(|c| {
+                    let d = c.offset(0, 0, -1);
+                    self.below.in_bounds(d) && self.below.get(d)
+                })
+                .collect()
+        };
         let owner = |c: Cell| -> Option<usize> {
             if !self.held.get(c) {
                 return None;
@@ -673,8 +1009,9 @@ impl<'a> Trace<'a> {
         };
         let (nx, ny, nz) = self.left.dims();
         let mut seen = VoxelGrid::new(nx, ny, nz);
-        let mut stack = vec![start];
-        seen.set(start, true);
+        for &c in &stack {
+            seen.set(c, true);
+        }
         let mut n = 0usize;
         while let Some(c) = stack.pop() {
             n += 1;
@@ -695,27 +1032,71 @@ impl<'a> Trace<'a> {
     }
 
     /// Whether every free cell (left, and no matched piece's) is a cell of
-    /// some piece of the alphabet whose cells are all free: the piece that
-    /// will be taken away with it. A cell no piece can cover is a dead end.
+    /// some piece of the alphabet whose cells are all free and which can
+    /// hold on to what is left: the piece that will be taken away with it.
+    /// In a shape a derivation can still build, every piece is stud-joined
+    /// to another (unless it is all that is left), so the piece's studs or
+    /// tubes meet a cell left outside it. A cell no such piece can cover is
+    /// a dead end: a free cell on a roof's edge with nothing above or
+    /// below, say, whose neighbour toward the middle is held by a matched
+    /// piece already. Each cell's last cover is kept and tried first.
     fn coverable(&self) -> bool {
-        if self.shapes.iter().any(|s| s.volume() == 1) {
-            return true;
-        }
-        self.left.cells().filter(|&c| !self.held.get(c)).all(|c| {
-            self.shapes.iter().any(|s| {
-                let k = s.cells().collect::<Vec<_>>();
-                k.iter().any(|q| {
+        let mut witness = self.witness.borrow_mut();
+        for c in self.left.cells() {
+            if self.held.get(c) {
+                continue;
+            }
+            if let Some(w) = witness.get(&c) {
+                if self.covers(w) {
+                    continue;
+                }
+            }
+            let found = self.shapes.iter().find_map(|s| {
+                s.cells().find_map(|q| {
                     let b = s.moved(c.x - q.x, c.y - q.y, c.z - q.z);
-                    self.free(&b)
+                    self.covers(&b).then_some(b)
                 })
-            })
-        })
+            });
+            match found {
+                Some(b) => {
+                    witness.insert(c, b);
+                }
+                None => return false,
+            }
+        }
+        true
     }
 
-    /// The last piece, if the trace is done: one pending piece is all that
-    /// is left, and a starting rule puts it down (or, above the first
-    /// part, a rule joins it to a piece below).
-    fn finished(&self) -> Option<Removal> {
+    /// Whether the piece `b` could be taken away as it stands: its cells
+    /// are free, and it holds on to a cell left outside it (or is all that
+    /// is left).
+    fn covers(&self, b: &Body) -> bool {
+        if !self.free(b) {
+            return false;
+        }
+        let v = b.volume() as usize;
+        if v == self.left_count {
+            return true;
+        }
+        let touches = |bx: CellBox| {
+            bx.cells()
+                .any(|d| self.left.in_bounds(d) && self.left.get(d) && !b.contains(d))
+        };
+        let grounded = b
+            .under_tubes()
+            .cells()
+            .any(|d| self.below.in_bounds(d) && self.below.get(d));
+        grounded || touches(b.over_studs()) || touches(b.under_tubes())
+    }
+
+    /// Whether the trace is done, and its last piece: in the first part,
+    /// one pending piece is all that is left and a starting rule puts it
+    /// down; above it, every piece is taken away (each joined to a piece
+    /// of the part or of the parts below), and there is no last piece.
+    fn finished(&self) -> Option<Option<Removal>> {
+        if !self.first {
+            return (self.left_count == 0).then_some(None);
+        }
         if self.pending.len() != 1 {
             return None;
         }
@@ -723,7 +1104,7 @@ impl<'a> Trace<'a> {
         if self.body(&p).volume() as usize != self.left_count {
             return None;
         }
-        self.closing(p)
+        self.closing(p).map(Some)
     }
 
     /// How the last piece `p` comes in: a starting rule for the first
@@ -771,8 +1152,8 @@ impl<'a> Trace<'a> {
 
     /// The derivation, forward: the last piece first, then the pieces
     /// taken away, last taken first.
-    fn derivation(&self, log: &[Change], last: Removal) -> Vec<Removal> {
-        let mut out = vec![last];
+    fn derivation(&self, log: &[Change], last: Option<Removal>) -> Vec<Removal> {
+        let mut out: Vec<Removal> = last.into_iter().collect();
         for c in log.iter().rev() {
             for &(p, a) in &c.taken {
                 out.push(Removal::forward(p, Anchor::Piece(a), Some(c.rule)));
