@@ -85,9 +85,10 @@ pub struct SearchOptions {
     /// there. Default (20, 150).
     pub branching: (u32, u32),
     /// Backward tracing: a pass of the tree that makes this many nodes
-    /// (times the Luby sequence's next term: 1, 1, 2, 1, 1, 2, 4, ...)
-    /// without an answer starts again from the root with new draws; 0
-    /// never. Default 300.
+    /// for each voxel of the part it traces (times the Luby sequence's
+    /// next term: 1, 1, 2, 1, 1, 2, 4, ...; at least 100) without an
+    /// answer starts again from the root with new draws; 0 never.
+    /// Default 4.
     pub restart: u64,
     /// Backward tracing: the most tree nodes before it gives up. Default
     /// 1,000,000.
@@ -119,7 +120,7 @@ impl Default for SearchOptions {
             hollow: None,
             method: Method::Layout,
             branching: (20, 150),
-            restart: 300,
+            restart: 4,
             node_budget: 1_000_000,
             cut: true,
             cap_stairs: true,
@@ -164,7 +165,8 @@ impl SearchOptions {
         self
     }
 
-    /// Sets the backward tracing's restart length (0: never restart).
+    /// Sets the backward tracing's restart length, in nodes a voxel (0:
+    /// never restart).
     pub fn with_restart(mut self, nodes: u64) -> Self {
         self.restart = nodes;
         self

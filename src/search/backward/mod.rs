@@ -157,11 +157,19 @@ pub(super) fn build(
             &below_pieces,
             order.is_empty(),
         );
-        let part = t.run(&mut rng, &mut count);
-        let part = part.map_err(|stop| SearchError::Backward {
+        let part = t.run(&mut rng, &mut count).map_err(|stop| SearchError::Backward {
             why: match stop {
                 Stop::Exhausted => format!(
                     "every branch of the tree was tried: these rules cannot build part {} of {} (layers {lo} to {})",
+                    i + 1,
+                    cuts.len(),
+                    hi - 1
+                ),
+                Stop::Apart(c) => format!(
+                    "no piece can hold the voxel at ({}, {}, {}) to the rest (nothing above or below it within a piece's reach): these rules cannot build part {} of {} (layers {lo} to {})",
+                    c.x,
+                    c.y,
+                    c.z,
                     i + 1,
                     cuts.len(),
                     hi - 1

@@ -54,8 +54,9 @@ pub(super) struct Tuning {
     pub b_max: u32,
     pub complex_every: u32,
     pub node_budget: u64,
-    /// Nodes a pass makes (times the Luby sequence's term) before the
-    /// tree is searched again from its root; 0 never.
+    /// Nodes a pass makes for each voxel of the part (times the Luby
+    /// sequence's term, and at least [`MIN_RESTART`]) before the tree is
+    /// searched again from its root; 0 never.
     pub restart: u64,
     pub deadline: Instant,
 }
@@ -74,6 +75,10 @@ pub(super) struct Counters {
 pub(super) enum Stop {
     /// Every branch was tried: (Σ, R) cannot build the part.
     Exhausted,
+    /// The part's voxels cannot be one shape held by studs: no piece of
+    /// the alphabet covering this voxel holds on to the rest (a wing one
+    /// voxel thin, say, touching the body only at its side).
+    Apart(Cell),
     /// The node budget ran out.
     Nodes,
     /// The time budget ran out.
@@ -83,31 +88,78 @@ pub(super) enum Stop {
 /// A piece's shape: its part and turn.
 type Shape = (PartKind, Rot);
 
+/// The fewest nodes a pass makes before it restarts (times the Luby
+/// sequence's term): a small part's pass gets at least this many.
+pub(super) const MIN_RESTART: u64 = 100;
+
 /// Draws in a row that match nowhere before a node lists the rules that
 /// match it ([`Trace::draw_next`]).
-const MISSES: u32 = 64;
+const MISSES: u32 = 256;
 
 /// The rule variants by the shape of their new piece and of their anchor.
 pub(super) struct VariantIndex {
-    by_added: Vec<((PartKind, Rot), Vec<u32>)>,
-    by_anchor: Vec<((PartKind, Rot), Vec<u32>)>,
+    /// The shapes the rules' pieces take.
+    shapes: Vec<Shape>,
+    /// Each variant's anchor's and new piece's shape (index in `shapes`).
+    anchor_shape: Vec<usize>,
+    added_shape: Vec<usize>,
+    /// The variants (of weight above 0, only those joined where they put
+    /// their pieces) by the shape of their new piece, and of their anchor.
+    by_added: Vec<(usize, Vec<u32>)>,
+    by_anchor: Vec<(usize, Vec<u32>)>,
 }
 
 impl VariantIndex {
     pub fn new(rules: &RuleSet) -> VariantIndex {
-        let group = |key: &dyn Fn(&Variant) -> (PartKind, Rot)| {
-            let mut m: std::collections::BTreeMap<(PartKind, Rot), Vec<u32>> = Default::default();
-            for (i, v) in rules.variants().iter().enumerate() {
-                if v.weight > 0.0 {
-                    m.entry(key(v)).or_default().push(i as u32);
+        let vars = rules.variants();
+        let mut shapes: Vec<Shape> = vars
+            .iter()
+            .flat_map(|v| [(v.added, v.added_rot), (v.anchor, v.anchor_rot)])
+            .collect();
+        shapes.sort();
+        shapes.dedup();
+        let at = |s: Shape| shapes.binary_search(&s).expect("every shape is listed");
+        let anchor_shape: Vec<usize> = vars.iter().map(|v| at((v.anchor, v.anchor_rot))).collect();
+        let added_shape: Vec<usize> = vars.iter().map(|v| at((v.added, v.added_rot))).collect();
+        let layer = rules.layer_ldu();
+        // Whether each variant's two pieces are stud-joined where it puts
+        // them (so wherever it matches: the joint moves with them).
+        let joined: Vec<bool> = vars
+            .iter()
+            .map(|v| {
+                let a = Placement::new(v.anchor, Cell::new(0, 0, 0), v.anchor_rot).body(layer);
+                let (ox, oy, oz) = v.offset;
+                let b = Placement::new(v.added, Cell::new(ox, oy, oz), v.added_rot).body(layer);
+                if v.dir == Dir::Up {
+                    a.holds(&b)
+                } else {
+                    b.holds(&a)
+                }
+            })
+            .collect();
+        let group = |of: &[usize]| {
+            let mut m: Vec<(usize, Vec<u32>)> =
+                (0..shapes.len()).map(|s| (s, Vec::new())).collect();
+            for (i, v) in vars.iter().enumerate() {
+                if v.weight > 0.0 && joined[i] {
+                    m[of[i]].1.push(i as u32);
                 }
             }
-            m.into_iter().collect()
+            m.retain(|(_, l)| !l.is_empty());
+            m
         };
         VariantIndex {
-            by_added: group(&|v| (v.added, v.added_rot)),
-            by_anchor: group(&|v| (v.anchor, v.anchor_rot)),
+            by_added: group(&added_shape),
+            by_anchor: group(&anchor_shape),
+            shapes: shapes.clone(),
+            anchor_shape,
+            added_shape,
         }
+    }
+
+    /// The index of a shape in `shapes`, if a rule's piece takes it.
+    fn shape_index(&self, part: PartKind, rot: Rot) -> Option<usize> {
+        self.shapes.binary_search(&(part, rot)).ok()
     }
 }
 
@@ -208,6 +260,9 @@ pub(super) struct Trace<'a> {
     /// start, anchors a match may join (never taken away).
     ground: Vec<Placement>,
     ground_set: KeySet<Placement>,
+    /// The pieces a match may join that stay: pending ones and the ones
+    /// below.
+    stay: KeySet<Placement>,
     /// Whether this is the first part (its last piece needs a starting
     /// rule; the others' a rule joining it to the parts below).
     first: bool,
@@ -297,6 +352,7 @@ impl<'a> Trace<'a> {
             below_pieces,
             below,
             ground_set: ground.iter().copied().collect(),
+            stay: ground.iter().copied().collect(),
             ground,
             first,
             built: RefCell::new(built),
@@ -321,8 +377,8 @@ impl<'a> Trace<'a> {
     /// repeats little). Only a pass in which every node tried every rule
     /// proves the rules cannot build the part.
     ///
-    /// A pass also ends when it has made `restart` nodes times the next
-    /// term of the Luby sequence (1, 1, 2, 1, 1, 2, 4, ...) without an
+    /// A pass also ends when it has made `restart` nodes a voxel times
+    /// the next term of the Luby sequence (1, 1, 2, 1, 1, 2, 4, ...) without an
     /// answer: the tree is searched again from its root with new draws.
     /// A depth-first search whose draws fix a wrong piece near the root
     /// can spend its whole budget under it; the draws of another pass
@@ -336,11 +392,17 @@ impl<'a> Trace<'a> {
         if let Some(r) = self.single_piece() {
             return Ok(vec![r]);
         }
+        if let Some(c) = self.uncoverable() {
+            return Err(Stop::Apart(c));
+        }
         let all = self.rules.variants().len() as u32;
         for i in 1u32.. {
             let limit = match self.tuning.restart {
                 0 => u64::MAX,
-                r => count.nodes.saturating_add(r.saturating_mul(luby(i))),
+                r => {
+                    let base = r.saturating_mul(self.total as u64).max(MIN_RESTART);
+                    count.nodes.saturating_add(base.saturating_mul(luby(i)))
+                }
             };
             match self.pass(rng, count, limit)? {
                 Pass::Found(d) => return Ok(d),
@@ -593,33 +655,109 @@ impl<'a> Trace<'a> {
     /// its shape), not by trying each rule.
     fn matching(&self, node: &Frame, drawn: &KeySet<u32>) -> Vec<u32> {
         let vars = self.rules.variants();
-        let mut hit = vec![false; vars.len()];
-        for (shape, list) in &self.index.by_added {
-            let places = self.spots_at(node, *shape);
-            for &v in list {
-                if hit[v as usize] || drawn.contains(&v) {
-                    continue;
+        let ix = &self.index;
+        let mut hit: Vec<bool> = vec![false; vars.len()];
+        for &v in drawn {
+            // Drawn already: not listed again.
+            hit[v as usize] = true;
+        }
+        let mut found = vec![false; vars.len()];
+        // Whether a new piece at a place can go in from above (or below)
+        // is the same for every rule: found once a place.
+        let ways: RefCell<KeyMap<(Placement, bool), bool>> = RefCell::new(KeyMap::default());
+        let way_in = |b: &Placement, bb: &Body, up: bool| {
+            if let Some(&w) = ways.borrow().get(&(*b, up)) {
+                return w;
+            }
+            let w = self.can_place(bb, &[], up);
+            ways.borrow_mut().insert((*b, up), w);
+            w
+        };
+        // For each shape, where it is free (from each free cell) and where
+        // a piece of it stays (pending, or below the part): by origin.
+        let (nx, ny, nz) = self.left.dims();
+        let mut free_at: Vec<VoxelGrid> = Vec::with_capacity(ix.shapes.len());
+        for &(part, rot) in &ix.shapes {
+            let probe = self.body(&Placement::new(part, Cell::new(0, 0, 0), rot));
+            let key = probe.key();
+            let mut m = VoxelGrid::new(nx, ny, nz);
+            for c in self.left.cells() {
+                let o = c.offset(-key.x, -key.y, -key.z);
+                if !self.held.get(c)
+                    && self.left.in_bounds(o)
+                    && self.free(&probe.moved(o.x, o.y, o.z))
+                {
+                    m.set(o, true);
                 }
-                let var = &vars[v as usize];
-                hit[v as usize] = places
-                    .iter()
-                    .any(|b| self.match_at(var, *b, true).is_some());
+            }
+            free_at.push(m);
+        }
+        let mut stay_at: Vec<Option<VoxelGrid>> = vec![None; ix.shapes.len()];
+        for p in &self.stay {
+            if let Some(i) = ix.shape_index(p.part, p.rot) {
+                if self.left.in_bounds(p.origin) {
+                    stay_at[i]
+                        .get_or_insert_with(|| VoxelGrid::new(nx, ny, nz))
+                        .set(p.origin, true);
+                }
             }
         }
-        for (shape, list) in &self.index.by_anchor {
-            let places = self.spots_at(node, *shape);
-            for &v in list {
-                if hit[v as usize] || drawn.contains(&v) {
+        let ok_at = |shape: usize, o: Cell| {
+            free_at[shape].get(o) || stay_at[shape].as_ref().is_some_and(|m| m.get(o))
+        };
+        for (shape, list) in &ix.by_added {
+            for b in self.spots_at(node, ix.shapes[*shape]).iter() {
+                // A place no piece can reach is no rule's.
+                if self.ground_set.contains(b) {
                     continue;
                 }
-                let var = &vars[v as usize];
-                let (ox, oy, oz) = var.offset;
-                hit[v as usize] = places.iter().any(|a| {
-                    let b = Placement::new(var.added, a.origin.offset(ox, oy, oz), var.added_rot);
-                    self.match_at(var, b, false).is_some()
-                });
+                let bb = self.body(b);
+                let (up, down) = (way_in(b, &bb, true), way_in(b, &bb, false));
+                if !up && !down {
+                    continue;
+                }
+                for &v in list {
+                    let var = &vars[v as usize];
+                    if hit[v as usize] || !(if var.dir == Dir::Up { up } else { down }) {
+                        continue;
+                    }
+                    let (ox, oy, oz) = var.offset;
+                    if ok_at(ix.anchor_shape[v as usize], b.origin.offset(-ox, -oy, -oz)) {
+                        hit[v as usize] = true;
+                        found[v as usize] = true;
+                    }
+                }
             }
         }
+        for (shape, list) in &ix.by_anchor {
+            for a in self.spots_at(node, ix.shapes[*shape]).iter() {
+                if self.stay.contains(a) {
+                    // Its new pieces are in their own lists, done above.
+                    continue;
+                }
+                for &v in list {
+                    if hit[v as usize] {
+                        continue;
+                    }
+                    let var = &vars[v as usize];
+                    let (ox, oy, oz) = var.offset;
+                    let o = a.origin.offset(ox, oy, oz);
+                    let added = ix.added_shape[v as usize];
+                    if !ok_at(added, o) {
+                        continue;
+                    }
+                    let b = Placement::new(var.added, o, var.added_rot);
+                    if self.ground_set.contains(&b) {
+                        continue;
+                    }
+                    if way_in(&b, &self.body(&b), var.dir == Dir::Up) {
+                        hit[v as usize] = true;
+                        found[v as usize] = true;
+                    }
+                }
+            }
+        }
+        let hit = found;
         (0..vars.len() as u32)
             .filter(|&v| hit[v as usize])
             .collect()
@@ -805,7 +943,8 @@ impl<'a> Trace<'a> {
             if tried.contains(&(b, a)) {
                 continue;
             }
-            if let Some(c) = self.match_at(&var, b, of_b) {
+            let way_in = |_: &Placement, bb: &Body, up: bool| self.can_place(bb, &[], up);
+            if let Some(c) = self.match_at(&var, b, of_b, &way_in) {
                 return Some((c, k - 1));
             }
         }
@@ -814,28 +953,36 @@ impl<'a> Trace<'a> {
     /// Whether variant `var` matches with its new piece at `b` (a place
     /// from the new piece's list of places if `of_b`, else one its anchor
     /// makes from the anchor's list): its change.
-    fn match_at(&self, var: &Variant, b: Placement, of_b: bool) -> Option<Change> {
+    /// `way_in` says whether a piece can go in at its place from above
+    /// (or below).
+    fn match_at(
+        &self,
+        var: &Variant,
+        b: Placement,
+        of_b: bool,
+        way_in: &dyn Fn(&Placement, &Body, bool) -> bool,
+    ) -> Option<Change> {
         let (ox, oy, oz) = var.offset;
         let up = var.dir == Dir::Up;
         let a = Placement::new(var.anchor, b.origin.offset(-ox, -oy, -oz), var.anchor_rot);
-        let bb = self.body(&b);
-        let ab = self.body(&a);
-        // The rule's joint, as the grid has it.
-        let joined = if up { ab.holds(&bb) } else { bb.holds(&ab) };
-        if !joined {
-            return None;
-        }
         // The new piece free or matched (a place from its own list is
         // one of those, or a piece below); the anchor free, matched or
         // below (one from its list is).
         let a_pending = self.is_pending(&a) || self.ground_set.contains(&a);
-        let b_ok = if of_b {
-            !self.ground_set.contains(&b)
-        } else {
-            self.is_pending(&b) || self.free(&bb)
-        };
-        let a_ok = a_pending || !of_b || self.free(&ab);
-        if !b_ok || !a_ok || !self.can_place(&bb, &[], up) {
+        if of_b && self.ground_set.contains(&b) {
+            return None;
+        }
+        let bb = self.body(&b);
+        if !of_b && !self.is_pending(&b) && !self.free(&bb) {
+            return None;
+        }
+        let ab = self.body(&a);
+        if of_b && !a_pending && !self.free(&ab) {
+            return None;
+        }
+        // The rule's joint, as the grid has it.
+        let joined = if up { ab.holds(&bb) } else { bb.holds(&ab) };
+        if !joined || !way_in(&b, &bb, up) {
             return None;
         }
         Some(Change {
@@ -932,6 +1079,7 @@ impl<'a> Trace<'a> {
             self.held.set_body(&b, true);
             self.pending.push(*a);
             self.pending_set.insert(*a);
+            self.stay.insert(*a);
             self.hash ^= piece_hash(a, 1);
         }
         for (p, _) in &c_taken {
@@ -940,6 +1088,7 @@ impl<'a> Trace<'a> {
             if was {
                 self.pending.retain(|q| q != p);
                 self.pending_set.remove(p);
+                self.stay.remove(p);
                 self.held.set_body(&b, false);
                 self.hash ^= piece_hash(p, 1);
             }
@@ -966,6 +1115,7 @@ impl<'a> Trace<'a> {
             if was {
                 self.pending.push(*p);
                 self.pending_set.insert(*p);
+                self.stay.insert(*p);
                 self.held.set_body(&b, true);
                 self.hash ^= piece_hash(p, 1);
             }
@@ -975,6 +1125,7 @@ impl<'a> Trace<'a> {
             self.held.set_body(&b, false);
             self.pending.retain(|q| q != a);
             self.pending_set.remove(a);
+            self.stay.remove(a);
             self.hash ^= piece_hash(a, 1);
         }
     }
@@ -1041,6 +1192,11 @@ impl<'a> Trace<'a> {
     /// below, say, whose neighbour toward the middle is held by a matched
     /// piece already. Each cell's last cover is kept and tried first.
     fn coverable(&self) -> bool {
+        self.uncoverable().is_none()
+    }
+
+    /// A free cell no piece can be taken away with ([`Trace::coverable`]).
+    fn uncoverable(&self) -> Option<Cell> {
         let mut witness = self.witness.borrow_mut();
         for c in self.left.cells() {
             if self.held.get(c) {
@@ -1061,10 +1217,10 @@ impl<'a> Trace<'a> {
                 Some(b) => {
                     witness.insert(c, b);
                 }
-                None => return false,
+                None => return Some(c),
             }
         }
-        true
+        None
     }
 
     /// Whether the piece `b` could be taken away as it stands: its cells
