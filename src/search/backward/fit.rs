@@ -48,7 +48,9 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> boo
         column(0, b.min.z)
     };
     if clear(&straight) {
-        return true;
+        // Straight up it is out; straight down it passes under the build,
+        // which is no way in from a cavity the build shuts on every side.
+        return from_above || open(b, solid);
     }
     // The box one cell that way must be free: it is pressed on last.
     let dz = if from_above { 1 } else { -1 };
@@ -74,9 +76,37 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> boo
                 continue;
             }
             if out(n) {
-                return true;
+                // Out under the ground: only if the place is open.
+                return n.z + b.sz > 0 || open(b, solid);
             }
             if clear(&bx(n, b.sx, b.sy, b.sz)) {
+                seen.insert(n);
+                queue.push_back(n);
+            }
+        }
+    }
+    false
+}
+
+/// Whether the cells of `b` are joined, face to face through cells
+/// `solid` leaves empty, to the space beside the grid or above it (not
+/// below: the build stands on the table). A place shut in on every side
+/// by what is built (a hollow's inside under its closed shell) is not,
+/// though a box may pass under the ground to reach it.
+fn open(b: &CellBox, solid: &VoxelGrid) -> bool {
+    let (nx, ny, nz) = solid.dims();
+    let mut seen: HashSet<Cell> = b.cells().collect();
+    let mut queue: VecDeque<Cell> = b.cells().collect();
+    while let Some(c) = queue.pop_front() {
+        for (dx, dy, dz) in crate::geom::FACES {
+            let n = Cell::new(c.x + dx, c.y + dy, c.z + dz);
+            if n.z < 0 || seen.contains(&n) {
+                continue;
+            }
+            if n.x < 0 || n.y < 0 || n.x >= nx || n.y >= ny || n.z >= nz {
+                return true;
+            }
+            if !solid.get(n) {
                 seen.insert(n);
                 queue.push_back(n);
             }
@@ -134,5 +164,16 @@ mod tests {
         }
         assert!(!placeable(&wide, &g, true));
         assert!(placeable(&bx(Cell::new(2, 2, 2), 1, 1, 1), &g, true));
+    }
+
+    #[test]
+    fn a_piece_shut_in_on_the_table_cannot_come_in_from_under_the_build() {
+        // A 1x1 at the bottom, walled in on four sides and covered.
+        let b = bx(Cell::new(2, 2, 0), 1, 1, 1);
+        let g = grid(&[(1, 2, 0), (3, 2, 0), (2, 1, 0), (2, 3, 0), (2, 2, 1)]);
+        assert!(!placeable(&b, &g, false));
+        // With a side open, it comes in from below (under an overhang).
+        let g = grid(&[(1, 2, 0), (3, 2, 0), (2, 1, 0), (2, 2, 1)]);
+        assert!(placeable(&b, &g, false));
     }
 }
