@@ -12,10 +12,14 @@
 //! runs out, the search fails and says how far it got (nodes, backtracks,
 //! seconds), and no build is made.
 //!
-//! The first part ends in a starting rule; each part above ends in a rule
-//! joining its last piece to a piece of the parts below, so the parts
-//! combine into one derivation: the first part's, then the next part's, and
-//! so on up. Read backwards, it is the paper's rule sequence.
+//! The first part ends in a starting rule; a part above is traced with the
+//! pieces of the parts below in place, and a match may join one of them
+//! (the paper's parts "can easily be combined together as ... there are
+//! typically many voxels connecting the parts"): the lowest course of a
+//! roof can only be put on the walls, never pushed in under the course
+//! above it. The parts combine into one derivation: the first part's, then
+//! the next part's, and so on up. Read backwards, it is the paper's rule
+//! sequence.
 //!
 //! The layout's extras are not used here: no slope guide, no colour
 //! splits, no pieces outside the voxels; every piece fills voxels of the

@@ -5,28 +5,32 @@
 //! `B`, or a complex rule's pieces) in the voxels left, replaced by its `u`:
 //! `B`'s cells are taken away and `A` stays, now *matched* (pending): a
 //! piece of the answer whose cells are still there, to be taken away by a
-//! later match. Each node stores only its local change ([`Change`]); going
-//! back up the tree undoes it. The trace succeeds when one piece is left
-//! and a starting rule can put it down (for a part above the first, when a
-//! rule joins it to the parts below): read backwards, the matches are the
+//! later match. Above the first part, `A` may also be a piece of the parts
+//! below, which stays. Each node stores only its local change ([`Change`]);
+//! going back up the tree undoes it. The first part's trace succeeds when
+//! one piece is left and a starting rule can put it down, a part above
+//! when every piece is taken away: read backwards, the matches are the
 //! derivation.
 //!
-//! At each node, `b` rules are drawn from their weights' categorical
-//! distribution (without replacement, among rules whose new piece fits
-//! somewhere it may go) and tried in the order drawn; `b` grows from
-//! `b_min` to `b_max` as fewer voxels are left. Once every `complex_every`
-//! nodes, a complex rule picked with equal probability is tried first. A
-//! rule labelled `up` is matched scanning from the top of the grid down, a
-//! `down` rule from the bottom up, and each match the scan finds is
-//! a child, the first match first. A match must join the pieces matched so
+//! At each node, rules are drawn from their weights' categorical
+//! distribution (without replacement, [`super::draw`]) as the node needs
+//! them, and each that matches is tried in the order drawn, up to `b` of
+//! them; `b` grows from `b_min` to `b_max` as fewer voxels are left. Where
+//! draws keep missing, the node lists the rules that match it and draws
+//! among those ([`Trace::draw_next`]). Once every `complex_every` nodes, a
+//! complex rule picked with equal probability is tried first. A rule
+//! labelled `up` is matched scanning from the top of the grid down, a
+//! `down` rule from the bottom up, and each match the scan finds is a
+//! child, the first match first. A match must join the pieces matched so
 //! far (its new piece or its anchor is a matched piece, or stud-connects
-//! to one), except the first,
-//! and its new piece must be able to reach its place past what is built
-//! before it ([`super::fit`]). A node whose voxels fall apart, or that was
-//! met before and failed with every rule tried, is cut off, and so is a
-//! node this pass has searched already, reached again by taking the same
-//! pieces in another order (it stays open to the next pass); a node with
-//! no child left is backtracked from.
+//! to one), except the first, and its new piece must be able to reach its
+//! place past what is built before it ([`super::fit`]). A node whose voxels
+//! fall apart or leave a voxel no piece can hold, or that was met before
+//! and failed with every rule tried, is cut off, and so is a node this
+//! pass has searched already, reached again by taking the same pieces in
+//! another order (it stays open to the next pass); a node with no child
+//! left is backtracked from. Passes restart from the root on the Luby
+//! sequence ([`Trace::run`]).
 
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
