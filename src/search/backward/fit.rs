@@ -7,13 +7,17 @@
 //! voxel grid with the padded piece until it reaches some boundary or it
 //! is completely enclosed"). The piece's box is moved a cell at a time
 //! through empty cells, from its place, until it is clear of the grid
-//! (placeable) or no move is left (enclosed). Moving whole cells is the
-//! padding: a box never slips through a gap narrower than itself, nor past
-//! a corner it would graze. The straight paths, up and down, are tried
-//! first: they are nearly always the answer.
+//! (placeable) or no move is left (enclosed), by the moves the verifier
+//! allows ([`crate::assembly::verify`]): up and down freely, sideways only
+//! with the layers just above and below the box clear (the half voxel of
+//! padding its studs need), so the trace never makes a build the verifier
+//! refuses. Moving whole cells is the padding: a box never slips through a
+//! gap narrower than itself, nor past a corner it would graze. The straight
+//! paths, up and down, are tried first: they are nearly always the answer.
 
 use std::collections::{HashSet, VecDeque};
 
+use crate::assembly::verify::{escape, Escape};
 use crate::geom::{Cell, CellBox};
 use crate::voxel::VoxelGrid;
 
@@ -58,34 +62,12 @@ pub(super) fn placeable(b: &CellBox, solid: &VoxelGrid, from_above: bool) -> boo
     if !clear(&first) {
         return false;
     }
-    let out = |m: Cell| {
-        m.x + b.sx <= 0 || m.y + b.sy <= 0 || m.z + b.sz <= 0 || m.x >= nx || m.y >= ny || m.z >= nz
-    };
-    let mut seen: HashSet<Cell> = HashSet::new();
-    let mut queue: VecDeque<Cell> = VecDeque::new();
-    seen.insert(b.min);
-    seen.insert(first.min);
-    queue.push_back(first.min);
-    while let Some(m) = queue.pop_front() {
-        if seen.len() > MAX_VISITED {
-            return false;
-        }
-        for (dx, dy, dz) in crate::geom::FACES {
-            let n = Cell::new(m.x + dx, m.y + dy, m.z + dz);
-            if seen.contains(&n) {
-                continue;
-            }
-            if out(n) {
-                // Out under the ground: only if the place is open.
-                return n.z + b.sz > 0 || open(b, solid);
-            }
-            if clear(&bx(n, b.sx, b.sy, b.sz)) {
-                seen.insert(n);
-                queue.push_back(n);
-            }
-        }
-    }
-    false
+    // From there, the verifier's own moves: up and down freely, sideways a
+    // stud at a time with the studs clear above and below. It may pass
+    // under the build only to a place open to the side or above.
+    let (lo, hi) = (Cell::new(0, 0, 0), Cell::new(nx - 1, ny - 1, nz - 1));
+    let out = escape(b, lo, hi, |x| solid.any_set(x), MAX_VISITED);
+    out == Escape::Out && open(b, solid)
 }
 
 /// Whether the cells of `b` are joined, face to face through cells
@@ -120,7 +102,7 @@ mod tests {
     use super::*;
 
     fn grid(cells: &[(i32, i32, i32)]) -> VoxelGrid {
-        let mut g = VoxelGrid::new(5, 5, 5);
+        let mut g = VoxelGrid::new(5, 5, 6);
         for &(x, y, z) in cells {
             g.set(Cell::new(x, y, z), true);
         }
@@ -130,13 +112,18 @@ mod tests {
     #[test]
     fn a_piece_under_a_roof_slides_out_sideways_but_not_from_a_closed_box() {
         let b = bx(Cell::new(2, 2, 2), 1, 1, 1);
-        // A roof above and a floor below: it slides out to the side.
+        // A roof just above: not pressed on from above.
         let g = grid(&[(2, 2, 3), (2, 2, 1)]);
         assert!(!placeable(&b, &g, true));
+        // A roof higher up and a floor below: lowered to the layer over its
+        // place, studs clear above and below, it slides out to the side.
         let g = grid(&[(2, 2, 4), (2, 2, 1)]);
+        assert!(!placeable(&b, &g, true), "the roof just over the slide");
+        let g = grid(&[(2, 2, 5), (2, 2, 1)]);
         assert!(placeable(&b, &g, true));
         assert!(!placeable(&b, &g, false));
-        let g = grid(&[(2, 2, 3), (2, 2, 0)]);
+        // A roof above and nothing below: pushed up from under it.
+        let g = grid(&[(2, 2, 3)]);
         assert!(placeable(&b, &g, false));
         // Walled in on all six sides: enclosed.
         let g = grid(&[
