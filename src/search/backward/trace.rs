@@ -94,14 +94,14 @@ type Shape = (PartKind, Rot);
 
 /// The fewest nodes a pass makes before it restarts (times the Luby
 /// sequence's term): a small part's pass gets at least this many.
-pub(super) const MIN_RESTART: u64 = 100;
+const MIN_RESTART: u64 = 100;
 
 /// Draws in a row that match nowhere before a node lists the rules that
 /// match it ([`Trace::draw_next`]).
 const MISSES: u32 = 256;
 
 /// The rule variants by the shape of their new piece and of their anchor.
-pub(super) struct VariantIndex {
+struct VariantIndex {
     /// The shapes the rules' pieces take.
     shapes: Vec<Shape>,
     /// Each variant's anchor's and new piece's shape (index in `shapes`).
@@ -114,7 +114,7 @@ pub(super) struct VariantIndex {
 }
 
 impl VariantIndex {
-    pub fn new(rules: &RuleSet) -> VariantIndex {
+    fn new(rules: &RuleSet) -> VariantIndex {
         let vars = rules.variants();
         let mut shapes: Vec<Shape> = vars
             .iter()
