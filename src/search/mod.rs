@@ -88,7 +88,7 @@ pub struct SearchOptions {
     /// for each voxel of the part it traces (times the Luby sequence's
     /// next term: 1, 1, 2, 1, 1, 2, 4, ...; at least 100) without an
     /// answer starts again from the root with new draws; 0 never.
-    /// Default 4.
+    /// Default 2.
     pub restart: u64,
     /// Backward tracing: the most tree nodes before it gives up. Default
     /// 1,000,000.
@@ -120,7 +120,7 @@ impl Default for SearchOptions {
             hollow: None,
             method: Method::Layout,
             branching: (20, 150),
-            restart: 4,
+            restart: 2,
             node_budget: 1_000_000,
             cut: true,
             cap_stairs: true,
