@@ -155,3 +155,69 @@ fn the_luby_sequence_doubles_after_each_run_of_ones() {
     let terms: Vec<u64> = (1..=15).map(luby).collect();
     assert_eq!(terms, [1, 1, 2, 1, 1, 2, 4, 1, 1, 2, 1, 1, 2, 4, 8]);
 }
+
+/// The place-by-place list of the rules that match a node is the same set
+/// as trying each rule: at every step of a known derivation, and on a box
+/// with the default rules.
+#[test]
+fn listing_the_rules_that_match_agrees_with_trying_each() {
+    let check = |t: &Trace<'_>, frame: &Frame, what: &str| {
+        let listed = t.matching(frame, &KeySet::default());
+        let tried: Vec<u32> = (0..t.rules.variants().len() as u32)
+            .filter(|&v| t.rules.variants()[v as usize].weight > 0.0)
+            .filter(|&v| t.match_basic(v, frame, 0).is_some())
+            .collect();
+        assert_eq!(listed, tried, "{what}");
+    };
+    let rules = figure2();
+    let book = RuleBook::new(&rules);
+    let p = pieces();
+    let mut grid = VoxelGrid::new(7, 3, 6);
+    for q in &p {
+        grid.set_body(&q.body(24), true);
+    }
+    let below = VoxelGrid::new(7, 3, 6);
+    let mut t = Trace::new(&rules, &book, tuning(), grid, &below, &[], true);
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let count = Counters::default();
+    for (i, &(b, a)) in [(12, 7), (7, 5), (6, 4), (11, 10), (10, 4)]
+        .iter()
+        .enumerate()
+    {
+        let frame = t.frame(&mut rng, &count, None);
+        check(&t, &frame, &format!("figure 2, step {i}"));
+        let (b, a) = (p[b - 1], p[a - 1]);
+        let found = matches(&t, &frame);
+        let &(_, _, rule) = found.iter().find(|m| m.0 == b && m.1 == a).unwrap();
+        let c = Change {
+            rule,
+            taken: vec![(b, a)],
+            new_pending: if t.is_pending(&a) { vec![] } else { vec![a] },
+        };
+        t.apply(&c);
+    }
+    // The default rules (bricks) on a box of 4 x 3 studs, two courses: the
+    // root, and a node after the first child.
+    let rules = crate::grammar::default_rules()
+        .restricted(|p| p.spec().family() == crate::catalog::Family::Brick)
+        .unwrap();
+    let book = RuleBook::new(&rules);
+    let mut grid = VoxelGrid::new(4, 3, 2);
+    for c in [0, 1] {
+        for y in 0..3 {
+            for x in 0..4 {
+                grid.set(Cell::new(x, y, c), true);
+            }
+        }
+    }
+    let below = VoxelGrid::new(4, 3, 2);
+    let mut t = Trace::new(&rules, &book, tuning(), grid, &below, &[], true);
+    let frame = t.frame(&mut rng, &count, None);
+    check(&t, &frame, "box, root");
+    let (c, _) = (0..rules.variants().len() as u32)
+        .find_map(|v| t.match_basic(v, &frame, 0))
+        .unwrap();
+    t.apply(&c);
+    let frame = t.frame(&mut rng, &count, None);
+    check(&t, &frame, "box, second node");
+}
