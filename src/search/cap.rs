@@ -31,8 +31,10 @@
 //! every part is undone. The swaps together add at most one piece in
 //! `BUDGET_SHARE` of the layout's (and one swap at most `MAX_ADDED`),
 //! so that the build keeps its voxels a piece within about a tenth; the
-//! swaps that add one piece at most go first, all over the build, then
-//! those that add two, so that the budget caps the most edges; after
+//! swaps that cap the most stair columns for each piece they add go
+//! first, all over the build (a 2x8 brick along a roof's run, capped with
+//! two 2x4 slopes, before bricks across it capped at their ends), so that
+//! the budget caps the most edges; after
 //! them, neighbouring bricks merge into longer ones and neighbouring
 //! slopes facing the same way into wider ones (two 2x2 slopes into a
 //! 2x4), each merge undone with the swaps if they are.
@@ -113,9 +115,16 @@ const MAX_ADDED: usize = 2;
 struct Budget {
     /// Pieces, over all the swaps.
     pieces: usize,
-    /// Pieces, in one swap.
-    per_swap: usize,
+    /// Stair columns a swap must cap for each piece it adds.
+    min_yield: usize,
 }
+
+/// The passes of swaps, by the stair columns a swap must cap for each
+/// piece it adds: the swaps that cap the most for their pieces go first,
+/// so that the budget caps the most edges (a 2x8 brick along a roof's
+/// run capped with two 2x4 slopes adds two pieces for eight columns; a
+/// brick across it, capped at its end, one piece for two).
+const YIELDS: [usize; 4] = [4, 3, 2, 1];
 
 /// Passes of merging after the swaps.
 const MERGE_ROUNDS: usize = 4;
@@ -150,19 +159,21 @@ impl Layout<'_> {
         let live = self.pieces.iter().filter(|p| !p.gone).count();
         let mut budget = Budget {
             pieces: live / BUDGET_SHARE,
-            per_swap: MAX_ADDED,
+            min_yield: YIELDS[0],
         };
         // Roofs from the eaves up: a slope's front row may lie on the back
         // row of the slope capped just below it. Underneath, from the top
         // down.
-        // The cheap swaps first: one piece added at most, then two.
-        let passes =
-            (1..=MAX_ADDED).flat_map(|k| [(Shape::Slope, top, k), (Shape::Inverted, under, k)]);
-        for (kind, wanted, per_swap) in passes {
+        // The swaps that cap the most stair columns for each piece they
+        // add first, all over the build.
+        let passes = YIELDS
+            .into_iter()
+            .flat_map(|k| [(Shape::Slope, top, k), (Shape::Inverted, under, k)]);
+        for (kind, wanted, min_yield) in passes {
             if !wanted {
                 continue;
             }
-            budget.per_swap = per_swap;
+            budget.min_yield = min_yield;
             let mut order = bricks.clone();
             order.sort_by_key(|&id| {
                 let z = self.pieces[id as usize].body.bbox.min.z;
@@ -325,8 +336,8 @@ impl Layout<'_> {
             .filter(|&(k, _)| k > 0)
             .collect();
         sides.sort_by_key(|&(k, d)| (std::cmp::Reverse(k), d));
-        for (_, d) in sides {
-            if let Some((k, rest)) = self.swap_side(id, d, kind, budget) {
+        for (steps, d) in sides {
+            if let Some((k, rest)) = self.swap_side(id, d, kind, steps, budget) {
                 let mut more = 0;
                 if depth < MAX_DEPTH {
                     for r in rest {
@@ -432,6 +443,7 @@ impl Layout<'_> {
         id: u32,
         d: (i32, i32),
         kind: Shape,
+        steps: usize,
         budget: &mut Budget,
     ) -> Option<(usize, Vec<u32>)> {
         let p = self.pieces[id as usize];
@@ -472,7 +484,7 @@ impl Layout<'_> {
             // Pieces it adds to the build: within the swap's and the whole
             // pass's budget.
             let added = n.saturating_sub(1);
-            if added > budget.per_swap || added > budget.pieces {
+            if added > MAX_ADDED || added > budget.pieces || steps < budget.min_yield * added {
                 continue;
             }
             let fits = all.iter().all(|(pl, body)| self.swap_fits(pl, body));
