@@ -30,18 +30,22 @@
 //! slanting the way the mesh does, one colour). A swap that does not fit
 //! every part is undone. The swaps together add at most one piece in
 //! `BUDGET_SHARE` of the layout's (and one swap at most `MAX_ADDED`),
-//! so that the build keeps its voxels a piece within about a tenth; the
-//! swaps that cap the most stair columns for each piece they add go
-//! first, all over the build (a 2x8 brick along a roof's run, capped with
-//! two 2x4 slopes, before bricks across it capped at their ends), so that
-//! the budget caps the most edges; after
-//! them, neighbouring bricks merge into longer ones and neighbouring
-//! slopes facing the same way into wider ones (two 2x2 slopes into a
-//! 2x4), each merge undone with the swaps if they are.
+//! so that the build keeps its voxels a piece within about a tenth. The
+//! swaps are made in two orders and the build that caps the larger share
+//! of its stair edges is kept: the swaps that add one piece at most
+//! first, then those that add two (where the budget lasts, on organic
+//! models: one brick's swap can take the room of another's), or the swaps
+//! that cap the most stair columns for each piece they add first (where
+//! it runs out, on long roofs: a 2x8 brick along the run, capped with two
+//! 2x4 slopes, adds two pieces for eight columns; a brick across it,
+//! capped at its end, one piece for two). After them, neighbouring
+//! bricks merge into longer ones and neighbouring slopes facing the same
+//! way into wider ones (two 2x2 slopes into a 2x4), each merge undone
+//! with the swaps if they are.
 
 use super::layout::{Layout, Reach};
-use crate::assembly::Placement;
-use crate::catalog::{PartKind, Shape};
+use crate::assembly::{stairs, Assembly, Placement};
+use crate::catalog::{Color, PartKind, Shape};
 use crate::geom::{Body, Cell, CellBox, Rot};
 use crate::grammar::Dir;
 
@@ -115,16 +119,29 @@ const MAX_ADDED: usize = 2;
 struct Budget {
     /// Pieces, over all the swaps.
     pieces: usize,
+    /// Pieces, in one swap.
+    per_swap: usize,
     /// Stair columns a swap must cap for each piece it adds.
     min_yield: usize,
+}
+
+/// The order in which bricks are capped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Order {
+    /// The swaps that add one piece at most first, then two.
+    Cheap,
+    /// The swaps that cap the most stair columns for each piece they add
+    /// first (see [`YIELDS`]).
+    Yield,
 }
 
 /// The passes of swaps, by the stair columns a swap must cap for each
 /// piece it adds: the swaps that cap the most for their pieces go first,
 /// so that the budget caps the most edges (a 2x8 brick along a roof's
 /// run capped with two 2x4 slopes adds two pieces for eight columns; a
-/// brick across it, capped at its end, one piece for two).
-const YIELDS: [usize; 4] = [4, 3, 2, 1];
+/// brick across it, capped at its end, one piece for two); the last pass
+/// takes any swap the budget still allows.
+const YIELDS: [usize; 5] = [4, 3, 2, 1, 0];
 
 /// Passes of merging after the swaps.
 const MERGE_ROUNDS: usize = 4;
@@ -141,9 +158,8 @@ impl Layout<'_> {
     pub fn cap_stairs(&mut self) -> Vec<Swap> {
         let has = |s: Shape| self.shapes.iter().any(|p| p.part.spec().shape == s);
         let (top, under) = (has(Shape::Slope), has(Shape::Inverted));
-        let mut swaps = Vec::new();
         if !top && !under {
-            return swaps;
+            return Vec::new();
         }
         // Half-brick layers only: bricks two layers tall.
         let bricks: Vec<u32> = (0..self.pieces.len() as u32)
@@ -155,50 +171,108 @@ impl Layout<'_> {
                     && p.body.bbox.sz == 2
             })
             .collect();
-        let mut laid = 0;
         let live = self.pieces.iter().filter(|p| !p.gone).count();
-        let mut budget = Budget {
-            pieces: live / BUDGET_SHARE,
-            min_yield: YIELDS[0],
-        };
-        // Roofs from the eaves up: a slope's front row may lie on the back
-        // row of the slope capped just below it. Underneath, from the top
-        // down.
-        // The swaps that cap the most stair columns for each piece they
-        // add first, all over the build.
-        let passes = YIELDS
-            .into_iter()
-            .flat_map(|k| [(Shape::Slope, top, k), (Shape::Inverted, under, k)]);
-        for (kind, wanted, min_yield) in passes {
-            if !wanted {
-                continue;
-            }
-            budget.min_yield = min_yield;
-            let mut order = bricks.clone();
-            order.sort_by_key(|&id| {
-                let z = self.pieces[id as usize].body.bbox.min.z;
-                (if kind == Shape::Slope { z } else { -z }, id)
-            });
-            for id in order {
-                if self.pieces[id as usize].gone {
-                    continue;
-                }
-                let first = self.pieces.len() as u32;
-                if let Some(k) = self.cap_piece(id, kind, 0, &mut budget) {
-                    laid += k;
-                    swaps.push(Swap {
-                        taken: vec![id],
-                        laid: first..self.pieces.len() as u32,
-                        slopes: k,
-                    });
-                }
-            }
+        let pieces = live / BUDGET_SHARE;
+        // Both orders, and the one whose build caps the larger share of
+        // its stair edges (the fewer pieces if equal): the cheap swaps
+        // first cap more where the budget lasts (the swaps of one brick
+        // can take the room of another's), the best yield first where it
+        // runs out (a long roof).
+        let extra = self.repairs.extra_cells;
+        let mut tried = Vec::new();
+        for order in [Order::Cheap, Order::Yield] {
+            let (swaps, budget) = self.cap_in_order(&bricks, order, top, under, pieces);
+            let (capped, edges) = self.capped_edges();
+            tried.push((order, capped, edges, pieces - budget.pieces));
+            self.uncap(&swaps);
+            self.repairs.extra_cells = extra;
         }
-        if laid > 0 {
+        let better = |a: &(Order, usize, usize, usize), b: &(Order, usize, usize, usize)| {
+            // a's share against b's, then the pieces added.
+            (a.1 * b.2.max(1))
+                .cmp(&(b.1 * a.2.max(1)))
+                .then(b.3.cmp(&a.3))
+        };
+        let best = tried
+            .iter()
+            .copied()
+            .reduce(|a, b| if better(&b, &a).is_gt() { b } else { a })
+            .map_or(Order::Cheap, |t| t.0);
+        let mut swaps = self.cap_in_order(&bricks, best, top, under, pieces).0;
+        if swaps.iter().any(|s| s.slopes > 0) {
             self.merge_after(&mut swaps);
             self.rebuild_bodies();
         }
         swaps
+    }
+
+    /// The stair edges of the build as laid, top and underside together
+    /// (see [`stairs`]): how many are capped, of how many.
+    fn capped_edges(&self) -> (usize, usize) {
+        let order: Vec<Placement> = self
+            .pieces
+            .iter()
+            .filter(|p| !p.gone)
+            .map(|p| p.placement)
+            .collect();
+        let s = stairs::stair_edges(&Assembly::from_order(&order, self.layer_ldu, Color::RED));
+        (
+            s.capped.top + s.capped.underside,
+            s.edges.top + s.edges.underside,
+        )
+    }
+
+    /// Caps the stair edges of `bricks` in `order`, on top if `top`,
+    /// underneath if `under`, adding at most `pieces` pieces; the swaps
+    /// made and what is left of the budget.
+    fn cap_in_order(
+        &mut self,
+        bricks: &[u32],
+        order: Order,
+        top: bool,
+        under: bool,
+        pieces: usize,
+    ) -> (Vec<Swap>, Budget) {
+        let mut budget = Budget {
+            pieces,
+            per_swap: MAX_ADDED,
+            min_yield: 0,
+        };
+        let passes: Vec<(usize, usize)> = match order {
+            Order::Cheap => (1..=MAX_ADDED).map(|k| (k, 0)).collect(),
+            Order::Yield => YIELDS.iter().map(|&y| (MAX_ADDED, y)).collect(),
+        };
+        let mut swaps = Vec::new();
+        for (per_swap, min_yield) in passes {
+            for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
+                if !wanted {
+                    continue;
+                }
+                (budget.per_swap, budget.min_yield) = (per_swap, min_yield);
+                // Roofs from the eaves up: a slope's front row may lie on
+                // the back row of the slope capped just below it.
+                // Underneath, from the top down.
+                let mut ids = bricks.to_vec();
+                ids.sort_by_key(|&id| {
+                    let z = self.pieces[id as usize].body.bbox.min.z;
+                    (if kind == Shape::Slope { z } else { -z }, id)
+                });
+                for id in ids {
+                    if self.pieces[id as usize].gone {
+                        continue;
+                    }
+                    let first = self.pieces.len() as u32;
+                    if let Some(k) = self.cap_piece(id, kind, 0, &mut budget) {
+                        swaps.push(Swap {
+                            taken: vec![id],
+                            laid: first..self.pieces.len() as u32,
+                            slopes: k,
+                        });
+                    }
+                }
+            }
+        }
+        (swaps, budget)
     }
 
     /// Merges the bricks the swaps left with their neighbours where the
@@ -484,13 +558,15 @@ impl Layout<'_> {
             // Pieces it adds to the build: within the swap's and the whole
             // pass's budget.
             let added = n.saturating_sub(1);
-            if added > MAX_ADDED || added > budget.pieces || steps < budget.min_yield * added {
+            if added > budget.per_swap || added > budget.pieces || steps < budget.min_yield * added
+            {
                 continue;
             }
             let fits = all.iter().all(|(pl, body)| self.swap_fits(pl, body));
             if !fits || !self.still_joined(&all, &joined) {
                 continue;
             }
+
             budget.pieces -= added;
             let mut rest = Vec::new();
             for (placement, body) in all {
