@@ -179,26 +179,22 @@ impl Layout<'_> {
         // can take the room of another's), the best yield first where it
         // runs out (a long roof).
         let extra = self.repairs.extra_cells;
-        let mut tried = Vec::new();
-        for order in [Order::Cheap, Order::Yield] {
-            let (swaps, budget) = self.cap_in_order(&bricks, order, top, under, pieces);
-            let (capped, edges) = self.capped_edges();
-            tried.push((order, capped, edges, pieces - budget.pieces));
+        let (swaps, budget) = self.cap_in_order(&bricks, Order::Yield, top, under, pieces);
+        let by_yield = (self.capped_edges(), pieces - budget.pieces);
+        self.uncap(&swaps);
+        self.repairs.extra_cells = extra;
+        let (mut swaps, budget) = self.cap_in_order(&bricks, Order::Cheap, top, under, pieces);
+        let cheap = (self.capped_edges(), pieces - budget.pieces);
+        // The larger share capped, then the fewer pieces added.
+        let ((ky, ny), ay) = by_yield;
+        let ((kc, nc), ac) = cheap;
+        if (ky * nc.max(1), ac) > (kc * ny.max(1), ay) {
             self.uncap(&swaps);
             self.repairs.extra_cells = extra;
+            swaps = self
+                .cap_in_order(&bricks, Order::Yield, top, under, pieces)
+                .0;
         }
-        let better = |a: &(Order, usize, usize, usize), b: &(Order, usize, usize, usize)| {
-            // a's share against b's, then the pieces added.
-            (a.1 * b.2.max(1))
-                .cmp(&(b.1 * a.2.max(1)))
-                .then(b.3.cmp(&a.3))
-        };
-        let best = tried
-            .iter()
-            .copied()
-            .reduce(|a, b| if better(&b, &a).is_gt() { b } else { a })
-            .map_or(Order::Cheap, |t| t.0);
-        let mut swaps = self.cap_in_order(&bricks, best, top, under, pieces).0;
         if swaps.iter().any(|s| s.slopes > 0) {
             self.merge_after(&mut swaps);
             self.rebuild_bodies();
