@@ -187,6 +187,25 @@ fn a_shape_the_rules_cannot_build_fails_plainly() {
     assert!(e.contains("the node budget (3) ran out"), "{e}");
 }
 
+/// The mug fixture at 15 studs: its ring, one voxel thick, turns its
+/// corners by diagonal steps, and the disc under it is one layer thick, so
+/// the stretch of wall beyond a step is joined to the rest by no piece in
+/// the voxels. The trace says so before it starts, not when its budget
+/// ends.
+#[test]
+fn the_mug_as_voxelized_cannot_be_joined_and_says_so_at_once() {
+    let rules = bricks();
+    let shape = fixture_voxels("mug.obj", 15, &rules);
+    let e = search::build(&shape, &rules, &backward(1))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the backward search found no derivation: no pieces in the voxels can join the"),
+        "{e}"
+    );
+    assert!(e.contains("(0 nodes, 0 backtracks"), "{e}");
+}
+
 fn bricks() -> RuleSet {
     default_rules()
         .restricted(|p| p.spec().family() == Family::Brick)

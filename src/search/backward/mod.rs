@@ -27,6 +27,7 @@
 
 mod draw;
 mod fit;
+mod joinable;
 mod trace;
 
 use std::time::Instant;
@@ -141,6 +142,19 @@ pub(super) fn build(
     } else {
         vec![(0, voxels.dims().2)]
     };
+    // A shape whose voxels no pieces in them can hold together fails at
+    // once, not when the budget ends.
+    if let Some((c, n)) = joinable::unjoinable(&voxels, rules) {
+        return Err(SearchError::Backward {
+            why: format!(
+                "no pieces in the voxels can join the {n} voxels from ({}, {}, {}) to the rest (they touch it only along edges, or across a layer no piece spans): these rules cannot build the shape",
+                c.x, c.y, c.z
+            ),
+            nodes: 0,
+            backtracks: 0,
+            secs: started.elapsed().as_secs_f64(),
+        });
+    }
     let (nx, ny, nz) = voxels.dims();
     let mut below = VoxelGrid::new(nx, ny, nz);
     let mut below_pieces: Vec<Placement> = Vec::new();

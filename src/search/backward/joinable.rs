@@ -1,0 +1,154 @@
+//! Whether pieces laid in the voxels alone could ever hold them together:
+//! a test made once, before the trace, that fails at once on a shape no
+//! derivation builds however long it searches.
+//!
+//! Pieces hold each other only through studs, where a cell of one lies
+//! just above a cell of another. So in any build of the voxels, two
+//! voxels that each have a voxel above or below them (their *contacts*)
+//! are joined by a chain: up and down between pieces, and across a piece
+//! from one of its contacts to another. The test joins every two voxels
+//! one above the other, and all the contacts of every place a piece of the
+//! alphabet fits wholly in the voxels; if the contacts still fall into two
+//! groups, no build holds them together. (It may join more than a build
+//! can, as places that overlap share contacts, never less: a shape it
+//! passes may still be one the rules cannot build.) A one-voxel ring whose
+//! wall turns a corner by a diagonal step, standing on a disc one layer
+//! thick, is such a shape: no piece holds two voxels across an edge, and
+//! every piece under the straight stretch beyond the step reaches under
+//! that stretch alone.
+
+use crate::assembly::Placement;
+use crate::geom::{Cell, Rot};
+use crate::grammar::RuleSet;
+use crate::voxel::VoxelGrid;
+
+/// Above this many voxels times piece shapes, the test is not made (it
+/// visits every place every shape fits; the trace does not finish on
+/// shapes that big within any budget a user waits for).
+const MAX_WORK: usize = 50_000_000;
+
+/// A voxel whose contacts no piece joins to the rest (the first, bottom up,
+/// of the smaller group), and how many voxels that group holds; `None`
+/// when the contacts are one group (or the test is not made).
+pub(super) fn unjoinable(v: &VoxelGrid, rules: &RuleSet) -> Option<(Cell, usize)> {
+    let layer = rules.layer_ldu();
+    let mut shapes: Vec<_> = Vec::new();
+    for &part in rules.alphabet() {
+        for rot in Rot::ALL {
+            let b = Placement::new(part, Cell::new(0, 0, 0), rot).body(layer);
+            if !shapes.contains(&b) {
+                shapes.push(b);
+            }
+        }
+    }
+    if v.count().saturating_mul(shapes.len().max(1)) > MAX_WORK {
+        return None;
+    }
+    let contact = |c: Cell| v.get(c.offset(0, 0, 1)) || v.get(c.offset(0, 0, -1));
+    let mut parent: Vec<usize> = (0..v.len()).collect();
+    let find = |parent: &mut Vec<usize>, mut i: usize| {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    };
+    let unite = |parent: &mut Vec<usize>, a: usize, b: usize| {
+        let (ra, rb) = (find(parent, a), find(parent, b));
+        if ra != rb {
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    };
+    let cells: Vec<Cell> = v.cells().collect();
+    for &c in &cells {
+        let up = c.offset(0, 0, 1);
+        if v.get(up) {
+            unite(&mut parent, v.index(c), v.index(up));
+        }
+    }
+    // Every place a shape fits, from each voxel as its key cell.
+    for s in &shapes {
+        let key = s.key();
+        for &c in &cells {
+            let b = s.moved(c.x - key.x, c.y - key.y, c.z - key.z);
+            if !b.cells().all(|q| v.get(q)) {
+                continue;
+            }
+            let mut first: Option<usize> = None;
+            for q in b.cells().filter(|&q| contact(q)) {
+                let i = v.index(q);
+                match first {
+                    None => first = Some(i),
+                    Some(f) => unite(&mut parent, f, i),
+                }
+            }
+        }
+    }
+    let contacts: Vec<Cell> = cells.iter().copied().filter(|&c| contact(c)).collect();
+    let mut sizes: std::collections::BTreeMap<usize, (usize, Cell)> = Default::default();
+    for &c in &contacts {
+        let r = find(&mut parent, v.index(c));
+        sizes.entry(r).or_insert((0, c)).0 += 1;
+    }
+    if sizes.len() <= 1 {
+        return None;
+    }
+    // The smallest group (the first found if equal): the one to name.
+    sizes
+        .values()
+        .min_by_key(|(n, c)| (*n, (c.z, c.y, c.x)))
+        .map(|&(n, c)| (c, n))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grammar::default_rules;
+
+    fn bricks() -> RuleSet {
+        default_rules()
+            .restricted(|p| p.spec().family() == crate::catalog::Family::Brick)
+            .expect("the default rules have bricks")
+    }
+
+    #[test]
+    fn a_solid_box_is_one_group() {
+        let mut v = VoxelGrid::new(6, 4, 3);
+        for c in
+            (0..3).flat_map(|z| (0..4).flat_map(move |y| (0..6).map(move |x| Cell::new(x, y, z))))
+        {
+            v.set(c, true);
+        }
+        assert_eq!(unjoinable(&v, &bricks()), None);
+    }
+
+    #[test]
+    fn a_column_beside_a_wall_only_across_an_edge_falls_apart() {
+        // Two walls three layers high, on a one-layer floor, that touch
+        // only along an edge: the floor under the short wall reaches no
+        // further than the long one's floor cells under the short wall's
+        // own; no piece in the floor lies under both.
+        let mut v = VoxelGrid::new(12, 12, 3);
+        for z in 1..3 {
+            for x in 0..10 {
+                v.set(Cell::new(x, 0, z), true);
+            }
+            v.set(Cell::new(10, 1, z), true);
+            v.set(Cell::new(10, 2, z), true);
+        }
+        // The floor: under the long wall, and under the short one, with
+        // a gap no piece of the alphabet spans between them.
+        for x in 0..10 {
+            v.set(Cell::new(x, 0, 0), true);
+        }
+        v.set(Cell::new(10, 1, 0), true);
+        v.set(Cell::new(10, 2, 0), true);
+        let (c, n) = unjoinable(&v, &bricks()).expect("the short wall is joined to nothing");
+        assert_eq!((c, n), (Cell::new(10, 1, 0), 6));
+        // Filled at the step, the two are one.
+        for z in 0..3 {
+            v.set(Cell::new(10, 0, z), true);
+        }
+        assert_eq!(unjoinable(&v, &bricks()), None);
+    }
+}
