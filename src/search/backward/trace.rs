@@ -490,6 +490,11 @@ impl<'a> Trace<'a> {
             match child {
                 Some(c) => {
                     count.nodes += 1;
+                    // A match that leaves a matched piece held by nothing
+                    // splits the build: cut before it is applied.
+                    if self.strands(&c) {
+                        continue;
+                    }
                     self.apply(&c);
                     if self.failed.contains(&self.hash) || !self.connected() || !self.coverable() {
                         self.undo(&c);
@@ -1132,6 +1137,40 @@ impl<'a> Trace<'a> {
             self.stay.remove(a);
             self.hash ^= piece_hash(a, 1);
         }
+    }
+
+    /// Whether the match `c` would leave a matched piece (pending, or an
+    /// anchor it matches) with nothing left above or below it outside it,
+    /// and not on the parts below, while more than that piece is left: a
+    /// build split apart, as [`Trace::connected`] would find after it. Only
+    /// the pieces whose studs or tubes meet a piece taken away can lose
+    /// their hold.
+    fn strands(&self, c: &Change) -> bool {
+        let gone: Vec<Body> = c.taken.iter().map(|(p, _)| self.body(p)).collect();
+        let volume: usize = gone.iter().map(|g| g.volume() as usize).sum();
+        let left = self.left_count - volume;
+        let is_gone = |d: Cell| gone.iter().any(|g| g.contains(d));
+        let meets = |bx: CellBox| gone.iter().any(|g| g.bbox.intersects(&bx));
+        self.pending
+            .iter()
+            .chain(&c.new_pending)
+            .filter(|p| !c.taken.iter().any(|(t, _)| t == *p))
+            .any(|p| {
+                let b = self.body(p);
+                let (over, under) = (b.over_studs(), b.under_tubes());
+                if (b.volume() as usize) == left || !(meets(over) || meets(under)) {
+                    return false;
+                }
+                let held = |bx: CellBox| {
+                    bx.cells().any(|d| {
+                        self.left.in_bounds(d) && self.left.get(d) && !is_gone(d) && !b.contains(d)
+                    })
+                };
+                let grounded = under
+                    .cells()
+                    .any(|d| self.below.in_bounds(d) && self.below.get(d));
+                !(grounded || held(over) || held(under))
+            })
     }
 
     /// Whether what is left can still be one shape held together by
