@@ -17,8 +17,7 @@
 //! every piece under the straight stretch beyond the step reaches under
 //! that stretch alone.
 
-use crate::assembly::Placement;
-use crate::geom::{Cell, Rot};
+use crate::geom::Cell;
 use crate::grammar::RuleSet;
 use crate::voxel::VoxelGrid;
 
@@ -31,16 +30,7 @@ const MAX_WORK: usize = 50_000_000;
 /// of the smaller group), and how many voxels that group holds; `None`
 /// when the contacts are one group (or the test is not made).
 pub(super) fn unjoinable(v: &VoxelGrid, rules: &RuleSet) -> Option<(Cell, usize)> {
-    let layer = rules.layer_ldu();
-    let mut shapes: Vec<_> = Vec::new();
-    for &part in rules.alphabet() {
-        for rot in Rot::ALL {
-            let b = Placement::new(part, Cell::new(0, 0, 0), rot).body(layer);
-            if !shapes.contains(&b) {
-                shapes.push(b);
-            }
-        }
-    }
+    let shapes = super::trace::coverers(rules);
     if v.count().saturating_mul(shapes.len().max(1)) > MAX_WORK {
         return None;
     }

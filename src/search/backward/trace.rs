@@ -1363,7 +1363,7 @@ impl<'a> Trace<'a> {
 }
 
 /// The bodies of the alphabet's pieces at the origin, every distinct turn.
-fn coverers(rules: &RuleSet) -> Vec<Body> {
+pub(super) fn coverers(rules: &RuleSet) -> Vec<Body> {
     let mut out: Vec<Body> = Vec::new();
     for &part in rules.alphabet() {
         for rot in Rot::ALL {

@@ -63,15 +63,21 @@ fn matches(t: &Trace<'_>, frame: &Frame) -> Vec<(Placement, Placement, RuleRef)>
     out
 }
 
+/// The voxels of `pieces`, in a grid the size of Figure 5's shape.
+fn grid_of(pieces: &[Placement]) -> VoxelGrid {
+    let mut grid = VoxelGrid::new(7, 3, 6);
+    for q in pieces {
+        grid.set_body(&q.body(24), true);
+    }
+    grid
+}
+
 #[test]
 fn a_known_derivation_is_found_step_by_step_in_reverse() {
     let rules = figure2();
     let book = RuleBook::new(&rules);
     let p = pieces();
-    let mut grid = VoxelGrid::new(7, 3, 6);
-    for q in &p {
-        grid.set_body(&q.body(24), true);
-    }
+    let grid = grid_of(&p);
     let below = VoxelGrid::new(7, 3, 6);
     let mut t = Trace::new(&rules, &book, tuning(), grid, &below, &[], true);
     // Backward: (piece taken away, its anchor), pieces numbered from 1 as
@@ -172,10 +178,7 @@ fn listing_the_rules_that_match_agrees_with_trying_each() {
     let rules = figure2();
     let book = RuleBook::new(&rules);
     let p = pieces();
-    let mut grid = VoxelGrid::new(7, 3, 6);
-    for q in &p {
-        grid.set_body(&q.body(24), true);
-    }
+    let grid = grid_of(&p);
     let below = VoxelGrid::new(7, 3, 6);
     let mut t = Trace::new(&rules, &book, tuning(), grid, &below, &[], true);
     let mut rng = ChaCha8Rng::seed_from_u64(1);
