@@ -9,9 +9,12 @@
 //!
 //! The check keeps the equilibrium found for the step before. A step adds
 //! pieces; their weight must be carried, and only the forces near them
-//! need change: the change is looked for among the new pieces and a few
-//! rings of contacts around them (the pieces in reach, the contacts among
-//! them and their grounds), as a small linear program whose unknowns are
+//! need change: the change is looked for among the new pieces, a way down
+//! from each to the ground, ways to the group's outermost grounded pieces
+//! (a weight anywhere shifts the reactions under the whole group: a head
+//! held out by a support column at its far side needs that column's way
+//! down) and a few rings of contacts around them (the pieces in reach,
+//! the contacts among them and their grounds), as a small linear program whose unknowns are
 //! the changes to those forces, bounded so that the new forces stay
 //! within their own bounds (compression pushes, tension pulls at most a
 //! stud's capacity), with every other force held as it was. The rings
@@ -43,6 +46,19 @@ const RINGS: [usize; 4] = [0, 1, 2, 4];
 
 /// A ring holding this share of the group is the whole group.
 const WHOLE_SHARE: f64 = 0.5;
+
+/// The directions on the table in which the group's outermost grounded
+/// pieces join the region (see [`Certifier::ways_to_footing`]).
+const FOOTING_DIRECTIONS: [(f64, f64); 8] = [
+    (1.0, 0.0),
+    (-1.0, 0.0),
+    (0.0, 1.0),
+    (0.0, -1.0),
+    (1.0, 1.0),
+    (1.0, -1.0),
+    (-1.0, 1.0),
+    (-1.0, -1.0),
+];
 
 /// Cost of a unit of compression, against 1 for a unit of tension: the
 /// change found pushes rather than pulls, keeping clutch for later steps.
@@ -236,6 +252,11 @@ impl<'a> Certifier<'a> {
             let way = self.way_down(&[new[i]], end);
             new.extend(way);
         }
+        // A weight anywhere shifts the whole group's ground reactions: the
+        // region reaches the group's outermost grounded pieces too (its
+        // footing, a support column at its far side).
+        let ways = self.ways_to_footing(&new, job, end);
+        new.extend(ways);
         let whole_at = (WHOLE_SHARE * job.pieces.len() as f64) as usize;
         let mut tried = 0;
         for (i, &rings) in RINGS.iter().enumerate() {
@@ -309,6 +330,71 @@ impl<'a> Certifier<'a> {
             self.local[p] = u32::MAX;
         }
         way
+    }
+
+    /// The pieces on shortest ways through contacts (before `end`) from the
+    /// pieces `from` to the outermost grounded pieces of `job`: the one
+    /// farthest in each of eight directions of the table.
+    fn ways_to_footing(&mut self, from: &[usize], job: &Job, end: usize) -> Vec<usize> {
+        let s = self.s;
+        let grounded = |p: usize| {
+            p < end && (s.loads[p].ground.is_some() || !s.loads[p].ground_studs.is_empty())
+        };
+        let mut footing: Vec<usize> = Vec::with_capacity(8);
+        for (dx, dy) in FOOTING_DIRECTIONS {
+            let reach = |p: usize| dx * s.loads[p].com.0 + dy * s.loads[p].com.1;
+            let far = job
+                .pieces
+                .iter()
+                .copied()
+                .filter(|&p| grounded(p))
+                .max_by(|&a, &b| reach(a).total_cmp(&reach(b)));
+            footing.extend(far.filter(|p| !footing.contains(p)));
+        }
+        if footing.is_empty() {
+            return Vec::new();
+        }
+        // Breadth first from `from`; `local` holds where each piece was
+        // reached from (the piece itself at the start).
+        let mut queue = std::collections::VecDeque::new();
+        let mut seen: Vec<usize> = Vec::new();
+        for &p in from {
+            if self.local[p] == u32::MAX {
+                self.local[p] = p as u32;
+                seen.push(p);
+                queue.push_back(p);
+            }
+        }
+        while let Some(p) = queue.pop_front() {
+            for &k in &self.touching[p] {
+                let c = &s.contacts[k];
+                if c.below.max(c.above) >= end {
+                    continue;
+                }
+                let q = if c.below == p { c.above } else { c.below };
+                if self.local[q] == u32::MAX {
+                    self.local[q] = p as u32;
+                    seen.push(q);
+                    queue.push_back(q);
+                }
+            }
+        }
+        let mut ways = Vec::new();
+        for g in footing {
+            let mut q = g;
+            // Back along the way until a piece of `from` or one taken.
+            while self.local[q] != u32::MAX && self.local[q] as usize != q {
+                ways.push(q);
+                let back = self.local[q] as usize;
+                // Taken: the rest of this way is too.
+                self.local[q] = q as u32;
+                q = back;
+            }
+        }
+        for p in seen {
+            self.local[p] = u32::MAX;
+        }
+        ways
     }
 
     /// The pieces before `end` within `rings` contacts of `from`, sorted.

@@ -383,6 +383,10 @@ pub struct StepsAnalysis {
     /// weight passes down to the ground through the faces pieces rest on
     /// (exact: no clutch is used, see the module docs).
     pub certified: usize,
+    /// Of the groups certified by a change to the kept equilibrium, those
+    /// whose change took the whole group's program (no region near the
+    /// new pieces had one).
+    pub whole_certified: usize,
     /// Every step up to the end (or the first failure, when asked to stop
     /// there) was checked; false when the deadline of
     /// [`analyze_steps_within`] cut the check short.

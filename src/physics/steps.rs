@@ -699,6 +699,7 @@ fn check_steps_in(
         solves,
         reused,
         certified,
+        whole_certified: cert.found[cert.found.len() - 1],
         complete,
         finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
     })

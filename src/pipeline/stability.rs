@@ -163,6 +163,9 @@ pub struct StabilityReport {
     /// Groups certified standing by a change to the equilibrium of the
     /// step before (see docs/stability.md).
     pub certified: usize,
+    /// Of those, the groups whose change took the program of the whole
+    /// group (no region near the new pieces had one).
+    pub whole_certified: usize,
 }
 
 /// A planned build: the search's outcome and its verified, grouped
@@ -357,6 +360,7 @@ struct Counts {
     solves: usize,
     reused: usize,
     certified: usize,
+    whole_certified: usize,
 }
 
 impl Counts {
@@ -364,6 +368,7 @@ impl Counts {
         self.solves += c.solves;
         self.reused += c.reused;
         self.certified += c.certified;
+        self.whole_certified += c.whole_certified;
     }
 }
 
@@ -821,6 +826,7 @@ fn report(
         solves: counts.solves,
         reused: counts.reused,
         certified: counts.certified,
+        whole_certified: counts.whole_certified,
     }
 }
 
