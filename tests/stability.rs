@@ -381,6 +381,11 @@ fn the_order_repair_puts_the_counterweight_before_the_overhang() {
     assert_eq!(fixed.moved.len(), 1);
     assert_eq!(fixed.moved[0].part, "3009");
     assert_eq!(fixed.moved[0].from_step, 2);
+    // The overhang alone has no equilibrium: the analysis says what falls
+    // (one program); with the counterweight, the equilibrium kept from
+    // the base is changed to hold both, and checked (no program of the
+    // whole structure).
+    assert_eq!((fixed.solves, fixed.certified), (1, 1), "{fixed:?}");
     assert!(verify(&fixed.assembly, None).is_ok());
     let again = analyze_steps(&fixed.assembly, &params, false).unwrap();
     assert_eq!(again.first_failure, None, "{again:?}");

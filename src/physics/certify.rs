@@ -90,6 +90,12 @@ pub(super) struct Certifier<'a> {
     touching: Vec<Vec<usize>>,
     /// Scratch: per piece, its place in the region (`u32::MAX`: none).
     local: Vec<u32>,
+    /// Per piece, whether it is placed: only contacts between placed
+    /// pieces carry forces.
+    on: Vec<bool>,
+    /// The pieces before this one are placed, at least (see
+    /// [`Certifier::place_to`]).
+    placed_to: usize,
     /// Certificates found, per ring (the last: the whole group).
     pub found: [usize; RINGS.len() + 1],
     /// Pieces in the regions of the certificates found, summed.
@@ -135,9 +141,94 @@ impl<'a> Certifier<'a> {
             f: vec![0.0; next],
             touching,
             local: vec![u32::MAX; n],
+            on: vec![false; n],
+            placed_to: 0,
             found: [0; RINGS.len() + 1],
             region_pieces: 0,
         }
+    }
+
+    /// Places piece `p`: its contacts with placed pieces may carry forces.
+    pub(super) fn place(&mut self, p: usize) {
+        self.on[p] = true;
+    }
+
+    /// Places every piece before `end` (a build order's first pieces).
+    pub(super) fn place_to(&mut self, end: usize) {
+        self.on[self.placed_to.min(end)..end].fill(true);
+        self.placed_to = self.placed_to.max(end);
+    }
+
+    /// Takes piece `p` away again (its forces are those of a
+    /// [`Certifier::forces`] kept from before it was placed).
+    pub(super) fn remove(&mut self, p: usize) {
+        self.on[p] = false;
+    }
+
+    /// The kept forces, to go back to (see [`Certifier::set_forces`]).
+    pub(super) fn forces(&self) -> &[f64] {
+        &self.f
+    }
+
+    /// Goes back to forces kept by [`Certifier::forces`].
+    pub(super) fn set_forces(&mut self, f: &[f64]) {
+        self.f.copy_from_slice(f);
+    }
+
+    /// The groups of placed pieces (joined by contacts between placed
+    /// pieces) that hold a piece of `new`, each with its pieces of `new`
+    /// (sorted).
+    pub(super) fn groups_with(&mut self, new: &[usize]) -> Vec<(Job, Vec<usize>)> {
+        let s = self.s;
+        let mut out = Vec::new();
+        let mut seen: Vec<usize> = Vec::new();
+        for &start in new {
+            if self.local[start] != u32::MAX || !self.on[start] {
+                continue;
+            }
+            self.local[start] = 0;
+            seen.push(start);
+            let (mut pieces, mut contacts) = (vec![start], Vec::new());
+            let mut i = 0;
+            while i < pieces.len() {
+                let p = pieces[i];
+                i += 1;
+                for &k in &self.touching[p] {
+                    let c = &s.contacts[k];
+                    if !(self.on[c.below] && self.on[c.above]) {
+                        continue;
+                    }
+                    if c.below == p {
+                        contacts.push(k);
+                    }
+                    let q = if c.below == p { c.above } else { c.below };
+                    if self.local[q] == u32::MAX {
+                        self.local[q] = 0;
+                        seen.push(q);
+                        pieces.push(q);
+                    }
+                }
+            }
+            pieces.sort_unstable();
+            contacts.sort_unstable();
+            let mut mine: Vec<usize> = new
+                .iter()
+                .copied()
+                .filter(|p| pieces.binary_search(p).is_ok())
+                .collect();
+            mine.sort_unstable();
+            let grounded = pieces.iter().any(|&p| s.grounded(p));
+            let job = Job {
+                pieces,
+                contacts,
+                grounded,
+            };
+            out.push((job, mine));
+        }
+        for p in seen {
+            self.local[p] = u32::MAX;
+        }
+        out
     }
 
     /// The forces of contact `k`, or of piece `p`'s ground, with the piece
@@ -156,13 +247,13 @@ impl<'a> Certifier<'a> {
     /// Piece `p`'s equations: its weight less the forces on it (vertical,
     /// then the moments about its centre of mass), counting contacts with
     /// pieces before `end` only.
-    fn residual(&self, p: usize, end: usize, vars: &mut Vec<Var>) -> [f64; 3] {
+    fn residual(&self, p: usize, vars: &mut Vec<Var>) -> [f64; 3] {
         let l = &self.s.loads[p];
         let mut r = [l.weight, 0.0, 0.0];
         vars.clear();
         for &k in &self.touching[p] {
             let c = &self.s.contacts[k];
-            if c.below.max(c.above) < end {
+            if self.on[c.below] && self.on[c.above] {
                 self.contact_vars(k, vars);
             }
         }
@@ -178,9 +269,9 @@ impl<'a> Certifier<'a> {
 
     /// Whether piece `p`'s equations hold (within [`Params::fall_tolerance`]
     /// of its weight, a moment within that force at its far edge).
-    fn balanced(&self, p: usize, end: usize, vars: &mut Vec<Var>) -> bool {
+    fn balanced(&self, p: usize, vars: &mut Vec<Var>) -> bool {
         let l = &self.s.loads[p];
-        let r = self.residual(p, end, vars);
+        let r = self.residual(p, vars);
         let e = &l.extent;
         let reach = (e.x1 - e.x0).max(e.y1 - e.y0).max(1.0);
         let t = self.tol * l.weight;
@@ -234,48 +325,58 @@ impl<'a> Certifier<'a> {
         }
     }
 
-    /// The verdict on group `job` after a step placed the pieces before
-    /// `end`, those from `begin` new: the kept forces changed near the new
-    /// pieces (see the module docs).
-    pub(super) fn certify(&mut self, job: &Job, begin: usize, end: usize) -> Verdict {
+    /// The verdict on group `job` of the placed pieces (see
+    /// [`Certifier::place`]), of which `new` (sorted) were placed since the
+    /// last verdict: the kept forces changed near the new pieces (see the
+    /// module docs).
+    pub(super) fn certify(&mut self, job: &Job, new: &[usize]) -> Verdict {
         let mut vars = Vec::new();
         // The kept forces must hold the old pieces already; if not (the
         // group failed before), only the whole group can mend them.
         let kept = job
             .pieces
             .iter()
-            .all(|&p| p >= begin || self.balanced(p, end, &mut vars));
-        let mut new: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
-        // The new weight leaves the region only through its grounds: the
-        // region holds a way down to the ground from each new piece.
-        for i in 0..new.len() {
-            let way = self.way_down(&[new[i]], end);
-            new.extend(way);
-        }
-        // A weight anywhere shifts the whole group's ground reactions: the
-        // region reaches the group's outermost grounded pieces too (its
-        // footing, a support column at its far side).
-        let ways = self.ways_to_footing(&new, job, end);
-        new.extend(ways);
+            .all(|&p| new.binary_search(&p).is_ok() || self.balanced(p, &mut vars));
         let whole_at = (WHOLE_SHARE * job.pieces.len() as f64) as usize;
+        // Mostly new (a group's first step): the whole group at once.
+        let near = kept && new.len() < whole_at;
+        let mut new = new.to_vec();
+        let mut footing = Vec::new();
+        if near {
+            // The new weight leaves the region only through its grounds:
+            // the region holds a way down to the ground from each new
+            // piece.
+            for i in 0..new.len() {
+                let way = self.way_down(&[new[i]]);
+                new.extend(way);
+            }
+            // A weight anywhere shifts the whole group's ground reactions:
+            // the region reaches the group's outermost grounded pieces too
+            // (its footing, a support column at its far side).
+            footing = self.ways_to_footing(&new, job);
+        }
         let mut tried = 0;
         for (i, &rings) in RINGS.iter().enumerate() {
-            if !kept {
+            if !near {
                 break;
             }
-            let region = self.region(&new, rings, end);
+            // The rings grow around the new pieces and their ways down.
+            let mut region = self.region(&new, rings);
+            region.extend_from_slice(&footing);
+            region.sort_unstable();
+            region.dedup();
             if region.len() >= whole_at || region.len() <= tried {
                 break;
             }
             tried = region.len();
-            let r = self.try_region(&region, job, end);
+            let r = self.try_region(&region, job);
             if let Some(Some(stress)) = r {
                 self.found[i] += 1;
                 self.region_pieces += region.len();
                 return Verdict::Stands(stress);
             }
         }
-        let r = self.try_region(&job.pieces, job, end);
+        let r = self.try_region(&job.pieces, job);
         match r {
             Some(Some(stress)) => {
                 self.found[RINGS.len()] += 1;
@@ -290,7 +391,7 @@ impl<'a> Certifier<'a> {
     /// The pieces on a way through contacts from the pieces `from` down to
     /// a piece on the ground (before `end`), lowest first at each turn;
     /// empty if none.
-    fn way_down(&mut self, from: &[usize], end: usize) -> Vec<usize> {
+    fn way_down(&mut self, from: &[usize]) -> Vec<usize> {
         use std::cmp::Reverse;
         let s = self.s;
         let mut heap = std::collections::BinaryHeap::new();
@@ -308,7 +409,7 @@ impl<'a> Certifier<'a> {
             }
             for &k in &self.touching[p] {
                 let c = &s.contacts[k];
-                if c.below.max(c.above) >= end {
+                if !(self.on[c.below] && self.on[c.above]) {
                     continue;
                 }
                 let q = if c.below == p { c.above } else { c.below };
@@ -335,10 +436,11 @@ impl<'a> Certifier<'a> {
     /// The pieces on shortest ways through contacts (before `end`) from the
     /// pieces `from` to the outermost grounded pieces of `job`: the one
     /// farthest in each of eight directions of the table.
-    fn ways_to_footing(&mut self, from: &[usize], job: &Job, end: usize) -> Vec<usize> {
+    fn ways_to_footing(&mut self, from: &[usize], job: &Job) -> Vec<usize> {
         let s = self.s;
+        let on = &self.on;
         let grounded = |p: usize| {
-            p < end && (s.loads[p].ground.is_some() || !s.loads[p].ground_studs.is_empty())
+            on[p] && (s.loads[p].ground.is_some() || !s.loads[p].ground_studs.is_empty())
         };
         let mut footing: Vec<usize> = Vec::with_capacity(8);
         for (dx, dy) in FOOTING_DIRECTIONS {
@@ -368,7 +470,7 @@ impl<'a> Certifier<'a> {
         while let Some(p) = queue.pop_front() {
             for &k in &self.touching[p] {
                 let c = &s.contacts[k];
-                if c.below.max(c.above) >= end {
+                if !(self.on[c.below] && self.on[c.above]) {
                     continue;
                 }
                 let q = if c.below == p { c.above } else { c.below };
@@ -398,7 +500,7 @@ impl<'a> Certifier<'a> {
     }
 
     /// The pieces before `end` within `rings` contacts of `from`, sorted.
-    fn region(&mut self, from: &[usize], rings: usize, end: usize) -> Vec<usize> {
+    fn region(&mut self, from: &[usize], rings: usize) -> Vec<usize> {
         let mut region: Vec<usize> = Vec::with_capacity(from.len());
         for &p in from {
             if self.local[p] == u32::MAX {
@@ -412,7 +514,7 @@ impl<'a> Certifier<'a> {
             for i in frontier..stop {
                 for &k in &self.touching[region[i]] {
                     let c = &self.s.contacts[k];
-                    if c.below.max(c.above) >= end {
+                    if !(self.on[c.below] && self.on[c.above]) {
                         continue;
                     }
                     for q in [c.below, c.above] {
@@ -437,16 +539,11 @@ impl<'a> Certifier<'a> {
     /// with the group's stress if found and checked, `Some(None)` if the
     /// program has no answer (none exists in this region), `None` if the
     /// solver failed or the check did not pass.
-    fn try_region(
-        &mut self,
-        region: &[usize],
-        job: &Job,
-        end: usize,
-    ) -> Option<Option<Vec<PieceStress>>> {
+    fn try_region(&mut self, region: &[usize], job: &Job) -> Option<Option<Vec<PieceStress>>> {
         for (i, &p) in region.iter().enumerate() {
             self.local[p] = i as u32;
         }
-        let found = self.solve_region(region, end);
+        let found = self.solve_region(region);
         for &p in region {
             self.local[p] = u32::MAX;
         }
@@ -464,22 +561,18 @@ impl<'a> Certifier<'a> {
             }
         }
         let mut scratch = Vec::new();
-        if !job
-            .pieces
-            .iter()
-            .all(|&p| self.balanced(p, end, &mut scratch))
-        {
+        if !job.pieces.iter().all(|&p| self.balanced(p, &mut scratch)) {
             for (v, f) in vars.iter().zip(before) {
                 self.f[v.at] = f;
             }
             return None;
         }
-        Some(Some(self.stress(job, end)))
+        Some(Some(self.stress(job)))
     }
 
     /// The stress of every piece of `job` in the kept forces: its usage is
     /// its most loaded stud's tension.
-    fn stress(&self, job: &Job, end: usize) -> Vec<PieceStress> {
+    fn stress(&self, job: &Job) -> Vec<PieceStress> {
         let mut vars = Vec::new();
         job.pieces
             .iter()
@@ -487,7 +580,7 @@ impl<'a> Certifier<'a> {
                 vars.clear();
                 for &k in &self.touching[p] {
                     let c = &self.s.contacts[k];
-                    if c.below.max(c.above) < end {
+                    if self.on[c.below] && self.on[c.above] {
                         self.contact_vars(k, &mut vars);
                     }
                 }
@@ -512,14 +605,14 @@ impl<'a> Certifier<'a> {
     /// The program of a region (its pieces numbered in `self.local`): the
     /// changes to the forces among its pieces and their grounds that
     /// balance every piece of it, each force kept within its bounds.
-    fn solve_region(&self, region: &[usize], end: usize) -> Found {
+    fn solve_region(&self, region: &[usize]) -> Found {
         let inside = |p: usize| self.local[p] != u32::MAX;
         let mut vars = Vec::new();
         for &p in region {
             for &k in &self.touching[p] {
                 let c = &self.s.contacts[k];
                 // Each contact once, from its upper piece.
-                if c.above == p && c.below.max(c.above) < end && inside(c.below) {
+                if c.above == p && self.on[c.below] && self.on[c.above] && inside(c.below) {
                     self.contact_vars(k, &mut vars);
                 }
             }
@@ -532,7 +625,7 @@ impl<'a> Certifier<'a> {
         let mut b = vec![0.0; rows];
         let mut scratch = Vec::new();
         for (i, &p) in region.iter().enumerate() {
-            b[3 * i..3 * i + 3].copy_from_slice(&self.residual(p, end, &mut scratch));
+            b[3 * i..3 * i + 3].copy_from_slice(&self.residual(p, &mut scratch));
         }
         let (mut colptr, mut rowval, mut nzval) = (vec![0], Vec::new(), Vec::new());
         let mut cost = Vec::with_capacity(nv);

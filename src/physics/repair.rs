@@ -8,8 +8,12 @@
 //! offered again with every later step until the structure holds them.
 //! A deferred piece takes with it every piece that can only connect
 //! through it, so each step still joins what is built (the rewriting
-//! system's guarantee). Each candidate step is checked with the full
-//! force analysis ([`analyze`]); nothing is accepted on a guess.
+//! system's guarantee). Each candidate step is checked as the step check
+//! does: the equilibrium kept from the steps before is changed to hold
+//! the new pieces, and the change found is checked against every equation
+//! and bound (see [`certify`](super::certify)); only where no change
+//! exists does the full force analysis ([`analyze`]) say which pieces
+//! fail. Nothing is accepted on a guess.
 //!
 //! The caller verifies the new order (connection and placeability) and
 //! checks every step again with [`analyze_steps`](super::analyze_steps).
@@ -18,6 +22,8 @@ use std::collections::BTreeSet;
 
 use serde::Serialize;
 
+use super::certify::{Certifier, Verdict};
+use super::model::Structure;
 use super::{analyze, Analysis, Params, PhysicsError};
 use crate::assembly::{Assembly, Placed, Step};
 
@@ -41,12 +47,15 @@ pub struct Reordered {
     pub assembly: Assembly,
     /// The pieces that moved to a later step, in the original order.
     pub moved: Vec<Moved>,
-    /// Force analyses run.
+    /// Force analyses run (a candidate step certified by a change to the
+    /// kept equilibrium needs none).
     pub solves: usize,
+    /// Candidate steps certified standing without one.
+    pub certified: usize,
 }
 
-/// Analyses a reorder may run, per step of the build, at most; a build
-/// that needs more is left as it is.
+/// Candidate steps a reorder may check, per step of the build, at most; a
+/// build that needs more is left as it is.
 const SOLVES_PER_STEP: usize = 4;
 
 /// Pieces a repaired step may hold at most: deferring more into one step
@@ -83,6 +92,13 @@ pub fn reorder(
         }
     }
     let budget = SOLVES_PER_STEP * groups.len();
+    let structure = Structure::new(assembly, params);
+    let mut cert = Certifier::new(&structure, params);
+    // The steps before the first failure stand: their equilibrium is
+    // found first (none there: every step is analysed).
+    let (mut started, mut certain) = (false, true);
+    let mut trials = 0;
+    let mut certified = 0;
     let mut placed: Vec<usize> = Vec::with_capacity(n);
     let mut is_placed = vec![false; n];
     let mut steps: Vec<Vec<usize>> = Vec::new();
@@ -95,9 +111,16 @@ pub fn reorder(
             for &i in &group {
                 placed.push(i);
                 is_placed[i] = true;
+                cert.place(i);
             }
             steps.push(group);
             continue;
+        }
+        if !started {
+            started = true;
+            let mut all = placed.clone();
+            all.sort_unstable();
+            certain = holds(&mut cert, &all);
         }
         let mut trial: BTreeSet<usize> = deferred.iter().copied().chain(group).collect();
         let mut held: BTreeSet<usize> = BTreeSet::new();
@@ -108,12 +131,40 @@ pub fn reorder(
             }
             // The step's own pieces first, then those it now holds.
             kept.sort_by_key(|&i| (was_deferred[i], i));
-            if solves >= budget || deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            if trials >= budget || deadline.is_some_and(|d| std::time::Instant::now() >= d) {
                 return Ok(None);
             }
-            solves += 1;
-            let analysis = analyze(&subset(assembly, &placed, &kept), params)?;
-            let failing = failing_new(&analysis, &placed, &kept, &neighbours);
+            trials += 1;
+            // The kept equilibrium changed to hold the new pieces, if it
+            // can be; else the analysis names the pieces that fail.
+            let before = cert.forces().to_vec();
+            for &i in &kept {
+                cert.place(i);
+            }
+            let mut new = kept.clone();
+            new.sort_unstable();
+            let failing = if certain && holds(&mut cert, &new) {
+                certified += 1;
+                Vec::new()
+            } else {
+                cert.set_forces(&before);
+                for &i in &kept {
+                    cert.remove(i);
+                }
+                solves += 1;
+                let analysis = analyze(&subset(assembly, &placed, &kept), params)?;
+                let failing = failing_new(&analysis, &placed, &kept, &neighbours);
+                if failing.is_empty() {
+                    // The analysis holds what no change to the kept
+                    // equilibrium did: from here on, every step is
+                    // analysed.
+                    certain = false;
+                    for &i in &kept {
+                        cert.place(i);
+                    }
+                }
+                failing
+            };
             if failing.is_empty() {
                 if kept.len() > MAX_REPAIRED_STEP {
                     return Ok(None);
@@ -193,7 +244,16 @@ pub fn reorder(
         },
         moved,
         solves,
+        certified,
     }))
+}
+
+/// Whether every group of `cert`'s placed pieces that holds a piece of
+/// `new` (sorted) stands, its kept equilibrium changed to hold them.
+fn holds(cert: &mut Certifier, new: &[usize]) -> bool {
+    cert.groups_with(new)
+        .iter()
+        .all(|(job, mine)| job.grounded && matches!(cert.certify(job, mine), Verdict::Stands(_)))
 }
 
 /// The pieces of `trial` that join what is built, in order: each stands

@@ -581,6 +581,7 @@ fn check_steps_in(
         }
         window.make_to(k + 1);
         let jobs = window.take(k);
+        cert.place_to(end);
         step_seconds = 0.0;
         let mut late = Vec::new();
         for job in &jobs {
@@ -601,7 +602,8 @@ fn check_steps_in(
             } else if !job.grounded || k == last_k && fin.covers_last() {
                 late.push(job);
             } else {
-                match cert.certify(job, begin, end) {
+                let new: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
+                match cert.certify(job, &new) {
                     Verdict::Stands(stress) => {
                         for (&p, st) in job.pieces.iter().zip(stress) {
                             current[p] = st;

@@ -497,6 +497,7 @@ fn attempt(
         let share = now + deadline.saturating_duration_since(now) / ORDER_SHARE;
         if let Some(r) = reorder(&plan.1, params, step, Some(share))? {
             counts.solves += r.solves;
+            counts.certified += r.certified;
             if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
                 let c = analyze_steps_within(&r.assembly, params, true, Some(deadline))?;
                 counts.add(&c);
