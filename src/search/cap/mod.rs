@@ -43,6 +43,8 @@
 //! way into wider ones (two 2x2 slopes into a 2x4), each merge undone
 //! with the swaps if they are.
 
+mod line;
+
 use super::layout::{Layout, Reach};
 use crate::assembly::{stairs, Assembly, Placement};
 use crate::catalog::{Color, PartKind, Shape};
@@ -163,13 +165,7 @@ impl Layout<'_> {
         }
         // Half-brick layers only: bricks two layers tall.
         let bricks: Vec<u32> = (0..self.pieces.len() as u32)
-            .filter(|&id| {
-                let p = &self.pieces[id as usize];
-                !p.gone
-                    && p.group.is_none()
-                    && p.placement.part.spec().shape == Shape::Rect
-                    && p.body.bbox.sz == 2
-            })
+            .filter(|&id| self.cappable(id))
             .collect();
         let live = self.pieces.iter().filter(|p| !p.gone).count();
         let pieces = live / BUDGET_SHARE;
@@ -239,21 +235,26 @@ impl Layout<'_> {
             Order::Yield => YIELDS.iter().map(|&y| (MAX_ADDED, y)).collect(),
         };
         let mut swaps = Vec::new();
+        // Lines of bricks across a roof's run first: capped together,
+        // they cost a piece for several stair columns (see [`line`]).
+        for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
+            if wanted {
+                let mut tried = std::collections::HashSet::new();
+                for id in self.eaves_up(bricks, kind) {
+                    if self.pieces[id as usize].gone {
+                        continue;
+                    }
+                    swaps.extend(self.cap_line(id, kind, &mut budget, &mut tried));
+                }
+            }
+        }
         for (per_swap, min_yield) in passes {
             for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
                 if !wanted {
                     continue;
                 }
                 (budget.per_swap, budget.min_yield) = (per_swap, min_yield);
-                // Roofs from the eaves up: a slope's front row may lie on
-                // the back row of the slope capped just below it.
-                // Underneath, from the top down.
-                let mut ids = bricks.to_vec();
-                ids.sort_by_key(|&id| {
-                    let z = self.pieces[id as usize].body.bbox.min.z;
-                    (if kind == Shape::Slope { z } else { -z }, id)
-                });
-                for id in ids {
+                for id in self.eaves_up(bricks, kind) {
                     if self.pieces[id as usize].gone {
                         continue;
                     }
@@ -269,6 +270,18 @@ impl Layout<'_> {
             }
         }
         (swaps, budget)
+    }
+
+    /// `bricks` from the eaves up for slopes of `kind` (a slope's front
+    /// row may lie on the back row of the slope capped just below it),
+    /// from the top down for inverted slopes.
+    fn eaves_up(&self, bricks: &[u32], kind: Shape) -> Vec<u32> {
+        let mut ids = bricks.to_vec();
+        ids.sort_by_key(|&id| {
+            let z = self.pieces[id as usize].body.bbox.min.z;
+            (if kind == Shape::Slope { z } else { -z }, id)
+        });
+        ids
     }
 
     /// Merges the bricks the swaps left with their neighbours where the
@@ -594,9 +607,15 @@ impl Layout<'_> {
             Some(r) => self.bricks_for(&r)?,
             None => Vec::new(),
         };
-        // Slopes along the run, longest first.
+        Some((self.slope_row(side, d, kind, deep)?, rest))
+    }
+
+    /// Slopes of `kind`, `deep` rows deep, along `side` (a row of cells
+    /// facing `d`, their row behind the front row on it), longest first;
+    /// `None` if the alphabet has none that fit.
+    fn slope_row(&self, side: &[Cell], d: (i32, i32), kind: Shape, deep: i32) -> Option<Vec<Part>> {
         let step = if d.0 != 0 { (0, 1) } else { (1, 0) };
-        let mut slopes: Vec<(Placement, Body)> = Vec::new();
+        let mut slopes: Vec<Part> = Vec::new();
         let width = side.len() as i32;
         let mut at = 0;
         while at < width {
@@ -605,7 +624,7 @@ impl Layout<'_> {
             slopes.push(placed);
             at += w;
         }
-        Some((slopes, rest))
+        Some(slopes)
     }
 
     /// Whether the pieces `joined` (which a brick just taken out joined)
