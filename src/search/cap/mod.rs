@@ -127,6 +127,25 @@ struct Budget {
     min_yield: usize,
 }
 
+/// What an order of the swaps made: the stair edges capped, of how many,
+/// and the pieces added.
+#[derive(Debug, Clone, Copy)]
+struct Capped {
+    edges: (usize, usize),
+    added: usize,
+}
+
+impl Capped {
+    /// Whether this caps a larger share of its stair edges than `other`,
+    /// or the same share with fewer pieces added (or as few, if `ties`).
+    fn better(&self, other: &Capped, ties: bool) -> bool {
+        let ((k, n), (ko, no)) = (self.edges, other.edges);
+        let (mine, theirs) = (k * no.max(1), ko * n.max(1));
+        mine > theirs
+            || (mine == theirs && (self.added < other.added || (ties && self.added == other.added)))
+    }
+}
+
 /// The order in which bricks are capped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Order {
@@ -135,6 +154,8 @@ enum Order {
     /// The swaps that cap the most stair columns for each piece they add
     /// first (see [`YIELDS`]).
     Yield,
+    /// Lines of bricks first (see [`line`]), then as [`Order::Yield`].
+    Lines,
 }
 
 /// The passes of swaps, by the stair columns a swap must cap for each
@@ -169,27 +190,40 @@ impl Layout<'_> {
             .collect();
         let live = self.pieces.iter().filter(|p| !p.gone).count();
         let pieces = live / BUDGET_SHARE;
-        // Both orders, and the one whose build caps the larger share of
+        // Each order, and the one whose build caps the larger share of
         // its stair edges (the fewer pieces if equal): the cheap swaps
         // first cap more where the budget lasts (the swaps of one brick
         // can take the room of another's), the best yield first where it
-        // runs out (a long roof).
+        // runs out (a long roof), lines of bricks first where a roof's
+        // courses are laid across its run.
         let extra = self.repairs.extra_cells;
-        let (swaps, budget) = self.cap_in_order(&bricks, Order::Yield, top, under, pieces);
-        let by_yield = (self.capped_edges(), pieces - budget.pieces);
-        self.uncap(&swaps);
-        self.repairs.extra_cells = extra;
-        let (mut swaps, budget) = self.cap_in_order(&bricks, Order::Cheap, top, under, pieces);
-        let cheap = (self.capped_edges(), pieces - budget.pieces);
-        // The larger share capped, then the fewer pieces added.
-        let ((ky, ny), ay) = by_yield;
-        let ((kc, nc), ac) = cheap;
-        if (ky * nc.max(1), ac) > (kc * ny.max(1), ay) {
-            self.uncap(&swaps);
-            self.repairs.extra_cells = extra;
-            swaps = self
-                .cap_in_order(&bricks, Order::Yield, top, under, pieces)
-                .0;
+        let mut swaps: Vec<Swap> = Vec::new();
+        let mut best: Option<(Order, Capped)> = None;
+        let mut last = None;
+        for order in [Order::Yield, Order::Cheap, Order::Lines] {
+            if last.is_some() {
+                self.uncap(&swaps);
+                self.repairs.extra_cells = extra;
+            }
+            let (made, budget) = self.cap_in_order(&bricks, order, top, under, pieces);
+            swaps = made;
+            last = Some(order);
+            let got = Capped {
+                edges: self.capped_edges(),
+                added: pieces - budget.pieces,
+            };
+            // Ties go to the cheap order over the best yield's, as before
+            // lines were tried, and to either over the lines'.
+            if best.is_none_or(|(_, b)| got.better(&b, order == Order::Cheap)) {
+                best = Some((order, got));
+            }
+        }
+        if let (Some((order, _)), Some(l)) = (best, last) {
+            if order != l {
+                self.uncap(&swaps);
+                self.repairs.extra_cells = extra;
+                swaps = self.cap_in_order(&bricks, order, top, under, pieces).0;
+            }
         }
         if swaps.iter().any(|s| s.slopes > 0) {
             self.merge_after(&mut swaps);
@@ -232,19 +266,18 @@ impl Layout<'_> {
         };
         let passes: Vec<(usize, usize)> = match order {
             Order::Cheap => (1..=MAX_ADDED).map(|k| (k, 0)).collect(),
-            Order::Yield => YIELDS.iter().map(|&y| (MAX_ADDED, y)).collect(),
+            Order::Yield | Order::Lines => YIELDS.iter().map(|&y| (MAX_ADDED, y)).collect(),
         };
         let mut swaps = Vec::new();
-        // Lines of bricks across a roof's run first: capped together,
-        // they cost a piece for several stair columns (see [`line`]).
-        for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
-            if wanted {
+        if order == Order::Lines {
+            // Capped together, a line of bricks across a roof's run costs
+            // a piece for several stair columns.
+            for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
                 let mut tried = std::collections::HashSet::new();
                 for id in self.eaves_up(bricks, kind) {
-                    if self.pieces[id as usize].gone {
-                        continue;
+                    if wanted && !self.pieces[id as usize].gone {
+                        swaps.extend(self.cap_line(id, kind, &mut budget, &mut tried));
                     }
-                    swaps.extend(self.cap_line(id, kind, &mut budget, &mut tried));
                 }
             }
         }
