@@ -31,14 +31,17 @@
 //! every part is undone. The swaps together add at most one piece in
 //! `BUDGET_SHARE` of the layout's (and one swap at most `MAX_ADDED`),
 //! so that the build keeps its voxels a piece within about a tenth. The
-//! swaps are made in two orders and the build that caps the larger share
-//! of its stair edges is kept: the swaps that add one piece at most
+//! swaps are made in three orders and the build that caps the larger
+//! share of its stair edges is kept: the swaps that add one piece at most
 //! first, then those that add two (where the budget lasts, on organic
-//! models: one brick's swap can take the room of another's), or the swaps
+//! models: one brick's swap can take the room of another's); the swaps
 //! that cap the most stair columns for each piece they add first (where
 //! it runs out, on long roofs: a 2x8 brick along the run, capped with two
 //! 2x4 slopes, adds two pieces for eight columns; a brick across it,
-//! capped at its end, one piece for two). After them, neighbouring
+//! capped at its end, one piece for two); or lines of bricks across a
+//! roof's run capped together first, then the best yield (see [`line`]:
+//! the line's slopes run across the bricks' seams, 2x4s where each brick
+//! took a 2x2). After them, neighbouring
 //! bricks merge into longer ones and neighbouring slopes facing the same
 //! way into wider ones (two 2x2 slopes into a 2x4), each merge undone
 //! with the swaps if they are.
