@@ -39,10 +39,10 @@
 //! it runs out, on long roofs: a 2x8 brick along the run, capped with two
 //! 2x4 slopes, adds two pieces for eight columns; a brick across it,
 //! capped at its end, one piece for two); or lines of bricks across a
-//! roof's run capped together first, then the best yield (see [`line`]:
-//! the line's slopes run across the bricks' seams, 2x4s where each brick
-//! took a 2x2). After them, neighbouring
-//! bricks merge into longer ones and neighbouring slopes facing the same
+//! roof's run capped together first, then the best yield (see
+//! [`line`](mod@line): the line's slopes run across the bricks' seams,
+//! 2x4s where each brick took a 2x2). After them, neighbouring bricks
+//! merge into longer ones and neighbouring slopes facing the same
 //! way into wider ones (two 2x2 slopes into a 2x4), each merge undone
 //! with the swaps if they are.
 
@@ -157,7 +157,7 @@ enum Order {
     /// The swaps that cap the most stair columns for each piece they add
     /// first (see [`YIELDS`]).
     Yield,
-    /// Lines of bricks first (see [`line`]), then as [`Order::Yield`].
+    /// Lines of bricks first (see [`line`](mod@line)), then as [`Order::Yield`].
     Lines,
 }
 
