@@ -260,13 +260,13 @@ pub(crate) fn finish(path: &Path, raw: Mesh) -> Result<Mesh, MeshError> {
     }
     let total = raw.triangles.len();
     if total > 0 {
-        let used: Vec<Vec3> = raw
-            .triangles
-            .iter()
-            .flatten()
-            .map(|&i| raw.positions[i as usize])
-            .collect();
-        let (lo, hi) = bounds(&used);
+        let (lo, hi) = raw.triangles.iter().flatten().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &i| {
+                let p = raw.positions[i as usize];
+                (lo.min(p), hi.max(p))
+            },
+        );
         if (hi - lo).max_element() == 0.0 {
             return Err(MeshError::ZeroExtent { at: at() });
         }
@@ -274,9 +274,11 @@ pub(crate) fn finish(path: &Path, raw: Mesh) -> Result<Mesh, MeshError> {
     let mut remap = vec![u32::MAX; count];
     let mut mesh = Mesh {
         warnings: raw.warnings.clone(),
+        positions: Vec::with_capacity(count),
+        triangles: Vec::with_capacity(total),
         ..Mesh::default()
     };
-    let mut faces = Vec::new();
+    let mut faces = Vec::with_capacity(if raw.paint.is_some() { total } else { 0 });
     for (k, t) in raw.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| raw.positions[i as usize]);
         if a == b || b == c || a == c || (b - a).cross(c - a) == Vec3::ZERO {

@@ -14,6 +14,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::mtl::{self, MtlMaterial};
 use super::paint::{inside_folder, read_side_file, srgb_to_linear, TextureBudget, MAX_SIDE_FILE};
@@ -170,7 +171,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     // is missing or unreadable is a warning, and its faces go uncoloured.
     let folder = path.parent().unwrap_or(Path::new("."));
     let libs = RefCell::new(Libraries::default());
-    let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |name| {
+    let (models, _) = tobj::load_obj_buf(&mut Joined::new(&text), &opts, |name| {
         libs.borrow_mut().load(path, folder, name)
     })
     .map_err(|e| MeshError::Malformed {
@@ -189,7 +190,20 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         ..Mesh::default()
     };
     let paint = obj_materials(path, folder, &libs.materials, &used, &mut raw.warnings);
-    let mut faces = Vec::new();
+    // A face is coloured by a material or by vertex colours; when none
+    // is, the mesh has no paint (`finish` would drop it), and the faces'
+    // paint is not made: a big mesh's would take 80 bytes a triangle.
+    let painted = models.iter().any(|model| {
+        let m = &model.mesh;
+        !m.indices.is_empty()
+            && (m.material_id.is_some_and(|i| i < paint.materials.len())
+                || (m.vertex_color.len() == m.positions.len() && !m.vertex_color.is_empty()))
+    });
+    let mut faces = Vec::with_capacity(if painted {
+        models.iter().map(|m| m.mesh.indices.len() / 3).sum()
+    } else {
+        0
+    });
     for model in &models {
         let m = &model.mesh;
         let base = raw.positions.len() as u32;
@@ -209,6 +223,9 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             .map(|i| i as u32);
         let has_uv = m.texcoord_indices.len() == m.indices.len() && !m.texcoords.is_empty();
         let has_vc = m.vertex_color.len() == m.positions.len() && !m.vertex_color.is_empty();
+        if !painted {
+            continue;
+        }
         for (k, c) in m.indices.chunks_exact(3).enumerate() {
             let uv = has_uv
                 .then(|| {
@@ -235,19 +252,19 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             });
         }
     }
-    raw.paint = Some(Paint { faces, ..paint });
+    raw.paint = painted.then_some(Paint { faces, ..paint });
     finish(path, raw)
 }
 
-/// Checks the text line by line and returns what `tobj` is to read.
+/// Checks the text line by line and returns what `tobj` is to read, in
+/// pieces.
 ///
 /// Reports the first line with a bad vertex or face; `tobj` would either
-/// reject those without a line number or misread them.
-fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
-    let bad = |line: usize, reason: String| MeshError::Malformed {
-        at: Location::line(path, line),
-        reason,
-    };
+/// reject those without a line number or misread them. A big file is cut
+/// into pieces at statement boundaries, counted and checked in parallel:
+/// each piece starts from the vertices before it, so the text handed on
+/// and the first error (the earliest piece's) are those of one pass.
+fn prescan(path: &Path, bytes: &[u8]) -> Result<Vec<String>, MeshError> {
     let text = match std::str::from_utf8(bytes) {
         Ok(t) => t,
         Err(e) => {
@@ -255,28 +272,166 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<String, MeshError> {
                 .iter()
                 .filter(|&&b| b == b'\n')
                 .count();
-            return Err(bad(
-                line,
-                "not text (invalid UTF-8); is this really an OBJ file?".into(),
-            ));
+            return Err(MeshError::Malformed {
+                at: Location::line(path, line),
+                reason: "not text (invalid UTF-8); is this really an OBJ file?".into(),
+            });
         }
     };
+    let pieces = statement_pieces(text, rayon::current_num_threads() * 4);
     // Positive face indices may refer forward, so count all vertices first.
-    let (mut total, mut total_vt) = (0usize, 0usize);
-    for (_, l) in logical_lines(text) {
+    let counts: Vec<Counted> = pieces.par_iter().map(|p| count(p)).collect();
+    let total = counts.iter().fold(Counted::default(), |a, &c| a.then(c));
+    let starts = counts.iter().scan(Counted::default(), |before, &c| {
+        let start = *before;
+        *before = before.then(c);
+        Some(start)
+    });
+    let checked: Vec<Result<String, MeshError>> = pieces
+        .par_iter()
+        .zip(starts.collect::<Vec<_>>())
+        .map(|(p, start)| check(path, p, start, total))
+        .collect();
+    checked.into_iter().collect()
+}
+
+/// The checked pieces of a file read one after another, as one text,
+/// without joining them (a copy of a big file).
+struct Joined<'a> {
+    pieces: &'a [String],
+    /// The piece being read, and the bytes of it read.
+    at: usize,
+    read: usize,
+}
+
+impl<'a> Joined<'a> {
+    fn new(pieces: &'a [String]) -> Self {
+        Joined {
+            pieces,
+            at: 0,
+            read: 0,
+        }
+    }
+}
+
+impl std::io::Read for Joined<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        use std::io::BufRead;
+        let left = self.fill_buf()?;
+        let n = left.len().min(buf.len());
+        buf[..n].copy_from_slice(&left[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl std::io::BufRead for Joined<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        while self
+            .pieces
+            .get(self.at)
+            .is_some_and(|p| self.read >= p.len())
+        {
+            self.at += 1;
+            self.read = 0;
+        }
+        Ok(self
+            .pieces
+            .get(self.at)
+            .map_or(&[][..], |p| &p.as_bytes()[self.read..]))
+    }
+
+    fn consume(&mut self, n: usize) {
+        self.read += n;
+    }
+}
+
+/// Physical lines, vertices and texture coordinates in a piece of the
+/// file (or before it).
+#[derive(Debug, Default, Clone, Copy)]
+struct Counted {
+    lines: usize,
+    v: usize,
+    vt: usize,
+}
+
+impl Counted {
+    /// These counts followed by `o`'s.
+    fn then(self, o: Counted) -> Counted {
+        Counted {
+            lines: self.lines + o.lines,
+            v: self.v + o.v,
+            vt: self.vt + o.vt,
+        }
+    }
+}
+
+/// The counts of `piece`.
+fn count(piece: &str) -> Counted {
+    let mut c = Counted {
+        lines: piece.lines().count(),
+        ..Counted::default()
+    };
+    for (_, l) in logical_lines(piece) {
         match l.split_whitespace().next() {
-            Some("v") => total += 1,
-            Some("vt") => total_vt += 1,
+            Some("v") => c.v += 1,
+            Some("vt") => c.vt += 1,
             _ => {}
         }
     }
-    let mut seen = 0usize;
-    let mut seen_vt = 0usize;
+    c
+}
+
+/// `text` cut into about `n` pieces of whole statements: each ends with a
+/// line break that does not continue the line (`\` at its end). Pieces
+/// are at least 64 KiB, so a small file is one piece.
+fn statement_pieces(text: &str, n: usize) -> Vec<&str> {
+    let bytes = text.as_bytes();
+    let size = (bytes.len() / n.max(1)).max(1 << 16);
+    let mut pieces = Vec::new();
+    let mut start = 0;
+    while start < bytes.len() {
+        let mut end = (start + size).min(bytes.len());
+        loop {
+            let Some(j) = bytes[end..].iter().position(|&b| b == b'\n') else {
+                end = bytes.len();
+                break;
+            };
+            let nl = end + j;
+            let line_end = if nl > 0 && bytes[nl - 1] == b'\r' {
+                nl - 1
+            } else {
+                nl
+            };
+            end = nl + 1;
+            if line_end == 0 || bytes[line_end - 1] != b'\\' {
+                break;
+            }
+        }
+        // A line break is one byte, so `end` is a character boundary.
+        pieces.push(&text[start..end]);
+        start = end;
+    }
+    pieces
+}
+
+/// Checks the statements of `piece`, which comes after `before` (lines,
+/// vertices and texture coordinates) in a file of `total`; returns the
+/// piece's text to hand on.
+fn check(path: &Path, piece: &str, before: Counted, total: Counted) -> Result<String, MeshError> {
+    let bad = |line: usize, reason: String| MeshError::Malformed {
+        at: Location::line(path, line),
+        reason,
+    };
+    let (total, total_vt) = (total.v, total.vt);
+    let mut seen = before.v;
+    let mut seen_vt = before.vt;
     // The text handed on: comments gone, continued lines joined, and face
     // corners cut to their vertex and texture indices, both checked
     // (`tobj` multiplies indices unchecked, and the mesh needs no normals).
-    let mut out = String::with_capacity(text.len());
-    for (no, line) in logical_lines(text) {
+    let mut out = String::with_capacity(piece.len());
+    for (no, line) in logical_lines(piece) {
+        let no = no + before.lines;
         if line.contains('\0') {
             return Err(bad(
                 no,
@@ -525,6 +680,50 @@ mod tests {
         assert!(msg.contains("bad.obj:2:"), "{msg}");
         let (_, msg) = err("v 0 0 0\nv 1 0 0\nf 1 x 2\n");
         assert!(msg.contains("bad.obj:3:") && msg.contains("\"x\""), "{msg}");
+    }
+
+    /// A file big enough to be checked in pieces: a strip of triangles,
+    /// every vertex written across two lines (`\\`), CRLF line ends.
+    fn big_strip(n: usize) -> String {
+        let mut s = String::new();
+        for k in 0..n {
+            s += &format!("v {k} \\\r\n {} 0\r\n", k % 2);
+        }
+        for k in 1..n - 1 {
+            s += &format!("f {k} {} -1 # after vertex {}\r\n", k + 1, k + 2);
+        }
+        s
+    }
+
+    #[test]
+    fn a_big_file_checked_in_pieces_reads_as_one() {
+        let text = big_strip(20_000);
+        assert!(text.len() > 4 << 16, "several pieces");
+        for n in [1, 3, 8, 64] {
+            let pieces = super::statement_pieces(&text, n);
+            assert_eq!(pieces.concat(), text);
+            for p in &pieces {
+                let last = p.trim_end_matches('\n').trim_end_matches('\r');
+                assert!(p.ends_with('\n') && !last.ends_with('\\'), "{n}");
+            }
+            if n == 64 {
+                assert!(pieces.len() > 4, "{}", pieces.len());
+            }
+        }
+        let f = write("strip.obj", text.as_bytes());
+        let m = load(&f.path).unwrap();
+        assert_eq!(m.triangles.len(), 19_998);
+        // Errors deep in the file name their line, counted over every
+        // piece before (two lines a vertex).
+        let bad_vertex = text.replacen("v 15000 \\\r\n 0 0", "v 15000 \\\r\n zero 0", 1);
+        let (_, msg) = err(&bad_vertex);
+        assert!(msg.contains("bad.obj:30001:"), "{msg}");
+        let bad_face = format!("{text}f 1 2 20001\r\n");
+        let (_, msg) = err(&bad_face);
+        assert!(
+            msg.contains("bad.obj:59999:") && msg.contains("20001"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -44,7 +44,7 @@
 //! narrower than a cell) are kept only where a ray happens to hit them.
 //!
 //! Everything is deterministic: fixed iteration orders, no hashing order,
-//! no threads.
+//! and threads only where the result cannot depend on them.
 //!
 //! # Example
 //!
@@ -70,8 +70,6 @@
 //! assert_eq!(model.grid.count(), 900);
 //! # Ok::<(), brickwright::voxel::VoxelizeError>(())
 //! ```
-
-use std::collections::HashSet;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -513,32 +511,65 @@ pub fn fill(tris: &[[DVec3; 3]], dims: [usize; 3]) -> VoxelGrid {
 
 /// The triangles of `mesh` in the grid frame (f64), with exact duplicates
 /// (the same three corners in any order) removed, first one kept.
+///
+/// Duplicates are found by sorting, not hashing, in parallel: each
+/// triangle's key (its corners' bits, in order) sorted with its index, so
+/// the first of a run of equal keys is the earliest triangle. A hash set of
+/// a million 36-byte keys was a quarter of a big mesh's voxelizing, most
+/// of it cache misses; the mesh's file decides the keys, so no hash that
+/// chosen keys can defeat either.
 fn unique_triangles(mesh: &Mesh, up: Up) -> Result<Vec<[DVec3; 3]>, VoxelizeError> {
     if mesh.triangles.is_empty() {
         return Err(VoxelizeError::EmptyMesh);
     }
     let count = mesh.positions.len();
-    let mut seen = HashSet::with_capacity(mesh.triangles.len());
-    let mut out = Vec::with_capacity(mesh.triangles.len());
-    for t in &mesh.triangles {
-        let mut corners = [Vec3::ZERO; 3];
-        for (c, &i) in corners.iter_mut().zip(t) {
-            let p = *mesh
+    let corner = |i: u32| mesh.positions.get(i as usize).filter(|p| p.is_finite());
+    // The first bad triangle, named as a walk in order would name it.
+    if let Some(k) = mesh
+        .triangles
+        .par_iter()
+        .position_first(|t| t.iter().any(|&i| corner(i).is_none()))
+    {
+        for &i in &mesh.triangles[k] {
+            let p = mesh
                 .positions
                 .get(i as usize)
                 .ok_or(VoxelizeError::IndexOutOfRange { index: i, count })?;
             if !p.is_finite() {
                 return Err(VoxelizeError::NonFinite { index: i });
             }
-            *c = to_grid_frame(p, up);
-        }
-        let mut key = corners.map(|p| p.to_array().map(f32::to_bits));
-        key.sort_unstable();
-        if seen.insert(key) {
-            out.push(corners.map(|p| p.as_dvec3()));
         }
     }
-    Ok(out)
+    let corners: Vec<[Vec3; 3]> = mesh
+        .triangles
+        .par_iter()
+        .map(|t| t.map(|i| to_grid_frame(mesh.positions[i as usize], up)))
+        .collect();
+    let mut keys: Vec<([[u32; 3]; 3], u32)> = corners
+        .par_iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let mut key = c.map(|p| p.to_array().map(f32::to_bits));
+            key.sort_unstable();
+            (key, k as u32)
+        })
+        .collect();
+    keys.par_sort_unstable();
+    let mut keep = vec![false; corners.len()];
+    let mut last = None;
+    for (key, k) in &keys {
+        if last != Some(key) {
+            keep[*k as usize] = true;
+            last = Some(key);
+        }
+    }
+    drop(keys);
+    Ok(corners
+        .par_iter()
+        .zip(&keep)
+        .filter(|(_, &k)| k)
+        .map(|(c, _)| c.map(|p| p.as_dvec3()))
+        .collect())
 }
 
 /// Where a ray through cell centres meets a triangle.
@@ -1012,6 +1043,46 @@ mod tests {
         assert_eq!(
             voxelize(&bad, &o),
             Err(VoxelizeError::NonFinite { index: 2 })
+        );
+    }
+
+    #[test]
+    fn duplicates_go_the_first_kept_in_order_and_the_first_bad_triangle_is_named() {
+        let positions: Vec<Vec3> = (0..40)
+            .map(|k| Vec3::new(k as f32, (k * k % 7) as f32, (k % 3) as f32))
+            .collect();
+        // Triangle k, and every fifth again later with its corners turned.
+        let mut triangles: Vec<[u32; 3]> = (0..30).map(|k| [k, k + 1, k + 5]).collect();
+        triangles.extend((0..30).step_by(5).map(|k| [k + 5, k, k + 1]));
+        triangles.insert(3, [7, 8, 12]);
+        let mesh = Mesh {
+            positions,
+            triangles,
+            ..Mesh::default()
+        };
+        let got = unique_triangles(&mesh, Up::Z).unwrap();
+        // Triangle 7 first comes fourth.
+        let mut order: Vec<usize> = (0..30).filter(|&k| k != 7).collect();
+        order.insert(3, 7);
+        let want: Vec<[DVec3; 3]> = order
+            .into_iter()
+            .map(|k| [k, k + 1, k + 5].map(|i| mesh.positions[i].as_dvec3()))
+            .collect();
+        assert_eq!(got, want);
+        let mut bad = mesh.clone();
+        bad.positions[9].y = f32::INFINITY;
+        bad.triangles[1] = [2, 3, 99];
+        assert_eq!(
+            unique_triangles(&bad, Up::Z),
+            Err(VoxelizeError::IndexOutOfRange {
+                index: 99,
+                count: 40
+            })
+        );
+        bad.triangles[1] = [2, 3, 4];
+        assert_eq!(
+            unique_triangles(&bad, Up::Z),
+            Err(VoxelizeError::NonFinite { index: 9 })
         );
     }
 
