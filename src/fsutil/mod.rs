@@ -174,6 +174,32 @@ mod tests {
     }
 
     #[test]
+    fn files_added_side_by_side_come_in_order_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let paths: Vec<_> = (0..40)
+            .map(|k| dir.path().join("steps").join(format!("{k}.txt")))
+            .collect();
+        let mut out = Outputs::new(dir.path()).unwrap();
+        let e = out
+            .add_all(&paths, |k, w| match k {
+                7 | 30 => Err(io::Error::other(format!("boom {k}"))),
+                _ => w.write_all(k.to_string().as_bytes()),
+            })
+            .unwrap_err();
+        assert_eq!(e.to_string(), "boom 7", "the first in order");
+        assert_eq!(out.paths().count(), 0);
+        out.add_all(&paths, |k, w| w.write_all(k.to_string().as_bytes()))
+            .unwrap();
+        assert!(out.paths().eq(paths.iter().map(PathBuf::as_path)));
+        // The build makes the pictures' folder itself, as here.
+        std::fs::create_dir(dir.path().join("steps")).unwrap();
+        out.commit().unwrap();
+        for (k, p) in paths.iter().enumerate() {
+            assert_eq!(std::fs::read_to_string(p).unwrap(), k.to_string());
+        }
+    }
+
+    #[test]
     fn a_blocked_target_leaves_the_old_outputs_untouched() {
         let dir = tempfile::tempdir().unwrap();
         let (a, b, c) = (

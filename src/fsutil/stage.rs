@@ -224,6 +224,44 @@ impl Outputs {
         Ok(())
     }
 
+    /// [`add`](Self::add) for each of `paths`, file `k` filled by
+    /// `fill(k, ..)`, the files made side by side on rayon's threads (a
+    /// build's step pictures: encoding and writing them one at a time
+    /// left a core idle). They are added in order; the first of them to
+    /// fail, in order, is the error, and none of them is then added.
+    pub fn add_all<F>(&mut self, paths: &[PathBuf], fill: F) -> io::Result<()>
+    where
+        F: Fn(usize, &mut dyn Write) -> io::Result<()> + Sync,
+    {
+        use rayon::prelude::*;
+        let staged = paths
+            .iter()
+            .map(|p| self.staged(p))
+            .collect::<io::Result<Vec<_>>>()?;
+        for dir in staged.iter().filter_map(|s| s.parent()) {
+            fs::create_dir_all(dir)?;
+        }
+        let results: Vec<io::Result<()>> = staged
+            .par_iter()
+            .enumerate()
+            .map(|(k, staged)| {
+                File::create(staged).and_then(|f| {
+                    let mut w = BufWriter::new(f);
+                    fill(k, &mut w)?;
+                    w.flush()
+                })
+            })
+            .collect();
+        if let Some(k) = results.iter().position(Result::is_err) {
+            for s in &staged {
+                let _ = fs::remove_file(s);
+            }
+            return results.into_iter().nth(k).unwrap_or(Ok(()));
+        }
+        self.files.extend(paths.iter().cloned());
+        Ok(())
+    }
+
     /// Where `path` is staged: `new/` plus its place under the folder.
     fn staged(&self, path: &Path) -> io::Result<PathBuf> {
         let rel = path

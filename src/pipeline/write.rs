@@ -130,11 +130,11 @@ pub(super) fn write(
                 refuse_link(&path)
                     .and_then(|()| made.create(&path))
                     .map_err(failed(&path))?;
-                let pngs = pictures::encode_all(&rendered.steps);
-                let paths = pictures::step_paths(&path, pngs.len());
-                pngs.iter()
-                    .zip(&paths)
-                    .try_for_each(|(png, p)| files.add(p, |w| w.write_all(png)))
+                // Each picture encoded and written on its own thread.
+                let paths = pictures::step_paths(&path, rendered.steps.len());
+                files.add_all(&paths, |k, w| {
+                    w.write_all(&pictures::encode(&rendered.steps[k]))
+                })
             }
             (Format::Png, Some(rendered)) => {
                 let png = pictures::encode(&rendered.model);

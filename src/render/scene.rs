@@ -87,11 +87,25 @@ impl Scene {
     /// The scene of an assembly: every piece's part mesh
     /// ([`part_mesh`]) placed exactly as its `.ldr` line places it
     /// ([`piece_transform`]), in its colour and step.
+    ///
+    /// The pieces' triangles are made on rayon's threads and added in
+    /// order: the same scene as adding them one by one.
     pub fn from_assembly(assembly: &Assembly) -> Scene {
+        use rayon::prelude::*;
+        let triangles: Vec<Vec<Triangle>> = assembly
+            .pieces
+            .par_iter()
+            .map(|p| {
+                let at = piece_transform(&p.placement, assembly.layer_ldu);
+                mesh_triangles(part_mesh(p.placement.part), at).collect()
+            })
+            .collect();
         let mut scene = Scene::new();
-        for p in &assembly.pieces {
-            let at = piece_transform(&p.placement, assembly.layer_ldu);
-            scene.add_part(p.placement.part, at, p.color, p.step);
+        scene
+            .triangles
+            .reserve(triangles.iter().map(Vec::len).sum());
+        for (p, t) in assembly.pieces.iter().zip(triangles) {
+            scene.add_piece(Rgb(p.color.rgb()), p.step, t);
         }
         scene
     }

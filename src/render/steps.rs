@@ -54,6 +54,7 @@ impl Eye {
         Eye {
             light: Light::for_camera(&camera),
             rects: (0..scene.pieces().len())
+                .into_par_iter()
                 .map(|i| piece_rect(scene, i, &camera))
                 .collect(),
             camera,

@@ -22,6 +22,8 @@ use super::scene::Scene;
 use crate::assembly::Step;
 use std::ops::Range;
 
+use rayon::prelude::*;
+
 /// The cost of a change of scale, in steps drawn at nothing (see
 /// [`stages`]): a change must make the pictures of several steps much
 /// fuller to be worth it.
@@ -52,18 +54,26 @@ pub(crate) fn frame(
     views: &[View],
     (width, height, margin): (u32, u32, u32),
 ) -> Framing {
-    // What is built by the end of each step, in each view.
-    let mut built = vec![Bounds::EMPTY; views.len()];
-    let mut prefix: Vec<Vec<Bounds>> = Vec::with_capacity(steps.len());
-    for (_, range) in steps {
-        for &i in &order[range.clone()] {
-            let points = scene.piece_triangles(i).iter().flat_map(|t| t.positions);
-            for (b, v) in built.iter_mut().zip(views) {
-                b.extend(v, points.clone());
-            }
-        }
-        prefix.push(built.clone());
-    }
+    // What is built by the end of each step, in each view: the views side
+    // by side (each grown in step order, as one pass would).
+    let by_view: Vec<Vec<Bounds>> = views
+        .par_iter()
+        .map(|v| {
+            let mut built = Bounds::EMPTY;
+            steps
+                .iter()
+                .map(|(_, range)| {
+                    for &i in &order[range.clone()] {
+                        built.extend(v, scene.piece_triangles(i).iter().flat_map(|t| t.positions));
+                    }
+                    built
+                })
+                .collect()
+        })
+        .collect();
+    let prefix: Vec<Vec<Bounds>> = (0..steps.len())
+        .map(|n| by_view.iter().map(|b| b[n]).collect())
+        .collect();
     let fit = |b: &[Bounds]| -> f32 {
         views
             .iter()
