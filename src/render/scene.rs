@@ -88,24 +88,31 @@ impl Scene {
     /// ([`part_mesh`]) placed exactly as its `.ldr` line places it
     /// ([`piece_transform`]), in its colour and step.
     ///
-    /// The pieces' triangles are made on rayon's threads and added in
-    /// order: the same scene as adding them one by one.
+    /// The pieces' triangles are made on rayon's threads a batch at a time
+    /// and added in order: the same scene as adding them one by one, with
+    /// no more than a batch held twice (a 5,000-piece build's scene is
+    /// about 150 MB).
     pub fn from_assembly(assembly: &Assembly) -> Scene {
         use rayon::prelude::*;
-        let triangles: Vec<Vec<Triangle>> = assembly
-            .pieces
-            .par_iter()
-            .map(|p| {
-                let at = piece_transform(&p.placement, assembly.layer_ldu);
-                mesh_triangles(part_mesh(p.placement.part), at).collect()
-            })
-            .collect();
+        const BATCH: usize = 256;
         let mut scene = Scene::new();
-        scene
-            .triangles
-            .reserve(triangles.iter().map(Vec::len).sum());
-        for (p, t) in assembly.pieces.iter().zip(triangles) {
-            scene.add_piece(Rgb(p.color.rgb()), p.step, t);
+        let most: usize = assembly
+            .pieces
+            .iter()
+            .map(|p| part_mesh(p.placement.part).indices.len() / 3)
+            .sum();
+        scene.triangles.reserve_exact(most);
+        for batch in assembly.pieces.chunks(BATCH) {
+            let made: Vec<Vec<Triangle>> = batch
+                .par_iter()
+                .map(|p| {
+                    let at = piece_transform(&p.placement, assembly.layer_ldu);
+                    mesh_triangles(part_mesh(p.placement.part), at).collect()
+                })
+                .collect();
+            for (p, t) in batch.iter().zip(made) {
+                scene.add_piece(Rgb(p.color.rgb()), p.step, t);
+            }
         }
         scene
     }
