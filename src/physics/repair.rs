@@ -9,11 +9,11 @@
 //! A deferred piece takes with it every piece that can only connect
 //! through it, so each step still joins what is built (the rewriting
 //! system's guarantee). Each candidate step is checked as the step check
-//! does: the equilibrium kept from the steps before is changed to hold
-//! the new pieces, and the change found is checked against every equation
-//! and bound (see [`certify`](super::certify)); only where no change
-//! exists does the full force analysis ([`analyze`]) say which pieces
-//! fail. Nothing is accepted on a guess.
+//! does (see [`physics`](super)): the equilibrium kept from the steps
+//! before is changed to hold the new pieces, and the change found is
+//! checked against every equation and bound; only where no change exists
+//! does the full force analysis ([`analyze`]) say which pieces fail.
+//! Nothing is accepted on a guess.
 //!
 //! The caller verifies the new order (connection and placeability) and
 //! checks every step again with [`analyze_steps`](super::analyze_steps).
