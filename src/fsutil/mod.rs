@@ -102,12 +102,14 @@ where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
     let dir = parent_dir(path);
+    let made = stage::making()?;
     let tmp = tempfile::Builder::new()
         .prefix(".brickwright-")
         .suffix(".part")
         .tempfile_in(dir)?;
     // Removed on Ctrl-C; dropped on an error, it goes by itself.
     stage::temp_file(tmp.path());
+    drop(made);
     let filled = (|| {
         let mut w = BufWriter::new(tmp.as_file());
         fill(&mut w)?;

@@ -25,7 +25,7 @@
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Component, Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::{Mutex, MutexGuard, RwLock, RwLockReadGuard};
 
 /// The start of a staging folder's name.
 const PREFIX: &str = ".brickwright-stage-";
@@ -53,12 +53,31 @@ fn pending() -> MutexGuard<'static, Vec<Pending>> {
     PENDING.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Whether the process is interrupted, under a lock that every thread
+/// making a file or folder for an output holds while it makes it: the
+/// Ctrl-C handler sets it (waiting for the makings under way) before it
+/// cleans up, so no thread makes a file or folder behind the clean-up (a
+/// step picture's staged file, written on another thread, recreated the
+/// staging folder after it was removed).
+static STOPPING: RwLock<bool> = RwLock::new(false);
+
+/// Leave to make an output's file or folder (held while making it), or
+/// an `Interrupted` error once the process is interrupted.
+pub(super) fn making() -> io::Result<RwLockReadGuard<'static, bool>> {
+    let stopping = STOPPING.read().unwrap_or_else(|e| e.into_inner());
+    if *stopping {
+        return Err(io::Error::new(io::ErrorKind::Interrupted, "interrupted"));
+    }
+    Ok(stopping)
+}
+
 /// Cleans up after an interrupted process: removes every staging folder
 /// whose renames have not begun (the old outputs stand), the empty folders
 /// made for them and any temporary file being written; waits for a commit
 /// under way to finish first. For the binary's Ctrl-C handler, which then
 /// exits; the list is left empty.
 pub fn interrupted() {
+    *STOPPING.write().unwrap_or_else(|e| e.into_inner()) = true;
     let mut list = pending();
     for p in list.drain(..) {
         let _ = match p {
@@ -184,6 +203,7 @@ impl Outputs {
     /// this run's staging folder.
     pub fn new(root: &Path) -> io::Result<Outputs> {
         recover(root)?;
+        let _made = making()?;
         let mut list = pending();
         let stage = tempfile::Builder::new()
             .prefix(PREFIX)
@@ -208,10 +228,13 @@ impl Outputs {
         F: FnOnce(&mut dyn Write) -> io::Result<()>,
     {
         let staged = self.staged(path)?;
+        let made = making()?;
         if let Some(dir) = staged.parent() {
             fs::create_dir_all(dir)?;
         }
-        let result = File::create(&staged).and_then(|f| {
+        let file = File::create(&staged);
+        drop(made);
+        let result = file.and_then(|f| {
             let mut w = BufWriter::new(f);
             fill(&mut w)?;
             w.flush()
@@ -238,14 +261,18 @@ impl Outputs {
             .iter()
             .map(|p| self.staged(p))
             .collect::<io::Result<Vec<_>>>()?;
-        for dir in staged.iter().filter_map(|s| s.parent()) {
-            fs::create_dir_all(dir)?;
+        {
+            let _made = making()?;
+            for dir in staged.iter().filter_map(|s| s.parent()) {
+                fs::create_dir_all(dir)?;
+            }
         }
         let results: Vec<io::Result<()>> = staged
             .par_iter()
             .enumerate()
             .map(|(k, staged)| {
-                File::create(staged).and_then(|f| {
+                let file = making().and_then(|_made| File::create(staged));
+                file.and_then(|f| {
                     let mut w = BufWriter::new(f);
                     fill(k, &mut w)?;
                     w.flush()
