@@ -51,8 +51,18 @@
 //!   variables a piece where residuals `r+ - r-` on three equations need
 //!   six.)
 //! - **Objective**: minimise `HAND_COST * sum(hand) + sum_j m_j +
-//!   1e-3 * sum(t)`: StableLego's sum of per-piece largest pull, plus a
-//!   little tension cost so that no tension is used where compression does.
+//!   1/2 * sum_j m_j^2 + 1e-3 * sum(t)`: StableLego's sum of per-piece
+//!   largest pull, plus a little tension cost so that no tension is used
+//!   where compression does, plus the usages' squares. The linear part
+//!   alone has many optima wherever a load can be shared among joints in
+//!   several ways at the same total, and an interior-point solver's answer
+//!   among them moves with its tolerance and its path (on the arch fixture
+//!   by 5.7e-5 with each Newton step refined). With the squares the cost is
+//!   strictly convex in the usages, so every joint's usage has one answer,
+//!   the program's and not the solver's (the same arch's usages within
+//!   6e-8 whether refined or at a tolerance of 1e-10); the squares also
+//!   spread a shared load over the joints that can take it, as clutch
+//!   does, rather than load one joint to spare another.
 //!
 //! A piece's **usage** is the largest `m_j` over its joints; at 1 or more
 //! the joint **breaks** (the piece would come off). Its **score** is
@@ -101,7 +111,8 @@
 //! where the program is exact: none found there, the step fails, and the
 //! group's force program below says which pieces fall or break off. The
 //! finished build is solved afresh with the force program, for the usage
-//! of every piece.
+//! of every piece: one answer, the same from [`analyze`] and from the
+//! step check's last step within 1e-6.
 //!
 //! Before any program is solved, the group gets a second, exact
 //! certificate: when every piece's weight can be passed down to the ground
