@@ -60,7 +60,10 @@
 //!   by 5.7e-5 with each Newton step refined). With the squares the cost is
 //!   strictly convex in the usages, so every joint's usage has one answer,
 //!   the program's and not the solver's (the same arch's usages within
-//!   6e-8 whether refined or at a tolerance of 1e-10); the squares also
+//!   6e-8 whether refined or at a tolerance of 1e-10; the bunny at 48
+//!   studs, 1,661 pieces in one program, within 1.3e-5, where the sum
+//!   alone moved by 3e-3: its faces' compression is still shared in many
+//!   ways, which the solver's path feels a little); the squares also
 //!   spread a shared load over the joints that can take it, as clutch
 //!   does, rather than load one joint to spare another.
 //!
