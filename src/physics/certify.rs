@@ -193,15 +193,10 @@ impl<'a> Certifier<'a> {
             while i < pieces.len() {
                 let p = pieces[i];
                 i += 1;
-                for &k in &self.touching[p] {
-                    let c = &s.contacts[k];
-                    if !(self.on[c.below] && self.on[c.above]) {
-                        continue;
-                    }
-                    if c.below == p {
+                for (k, q) in placed_contacts(s, &self.touching[p], &self.on, p) {
+                    if s.contacts[k].below == p {
                         contacts.push(k);
                     }
-                    let q = if c.below == p { c.above } else { c.below };
                     if self.local[q] == u32::MAX {
                         self.local[q] = 0;
                         seen.push(q);
@@ -407,12 +402,7 @@ impl<'a> Certifier<'a> {
                 reached = Some(p);
                 break;
             }
-            for &k in &self.touching[p] {
-                let c = &s.contacts[k];
-                if !(self.on[c.below] && self.on[c.above]) {
-                    continue;
-                }
-                let q = if c.below == p { c.above } else { c.below };
+            for (_, q) in placed_contacts(s, &self.touching[p], &self.on, p) {
                 if self.local[q] == u32::MAX {
                     self.local[q] = p as u32;
                     seen.push(q);
@@ -468,12 +458,7 @@ impl<'a> Certifier<'a> {
             }
         }
         while let Some(p) = queue.pop_front() {
-            for &k in &self.touching[p] {
-                let c = &s.contacts[k];
-                if !(self.on[c.below] && self.on[c.above]) {
-                    continue;
-                }
-                let q = if c.below == p { c.above } else { c.below };
+            for (_, q) in placed_contacts(s, &self.touching[p], &self.on, p) {
                 if self.local[q] == u32::MAX {
                     self.local[q] = p as u32;
                     seen.push(q);
@@ -512,16 +497,11 @@ impl<'a> Certifier<'a> {
         for _ in 0..rings {
             let stop = region.len();
             for i in frontier..stop {
-                for &k in &self.touching[region[i]] {
-                    let c = &self.s.contacts[k];
-                    if !(self.on[c.below] && self.on[c.above]) {
-                        continue;
-                    }
-                    for q in [c.below, c.above] {
-                        if self.local[q] == u32::MAX {
-                            self.local[q] = 0;
-                            region.push(q);
-                        }
+                let p = region[i];
+                for (_, q) in placed_contacts(self.s, &self.touching[p], &self.on, p) {
+                    if self.local[q] == u32::MAX {
+                        self.local[q] = 0;
+                        region.push(q);
                     }
                 }
             }
@@ -722,6 +702,21 @@ fn push_vars(
         });
         at += 1;
     }
+}
+
+/// The contacts (from piece `p`'s `touching`) between placed pieces (`on`),
+/// each with the piece on its other side.
+fn placed_contacts<'x>(
+    s: &'x Structure,
+    touching: &'x [usize],
+    on: &'x [bool],
+    p: usize,
+) -> impl Iterator<Item = (usize, usize)> + 'x {
+    touching.iter().filter_map(move |&k| {
+        let c = &s.contacts[k];
+        let q = if c.below == p { c.above } else { c.below };
+        (on[c.below] && on[c.above]).then_some((k, q))
+    })
 }
 
 /// +1 if force `v` pushes piece `p` up, -1 if down.
