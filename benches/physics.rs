@@ -27,13 +27,10 @@ use criterion::{criterion_main, BenchmarkId, Criterion};
 
 use std::path::Path;
 
-use brickwright::assembly::order::by_course;
-use brickwright::assembly::{Assembly, StepGrouping};
-use brickwright::catalog::{Color, Family};
+use brickwright::assembly::Assembly;
+use brickwright::catalog::Color;
 use brickwright::physics::support::shore_up;
 use brickwright::physics::{analyze, analyze_steps, Params};
-use brickwright::search::{self, SearchOptions};
-use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
 
 mod common;
 use common::block;
@@ -44,29 +41,7 @@ fn fixture_build(name: &str, studs: u32) -> Assembly {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures")
         .join(name);
-    let mesh = brickwright::mesh::load(&path).expect("fixture loads");
-    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
-    let model = voxelize(&mesh, &opts).expect("fixture voxelizes");
-    // Bricks only, as `build` has it without --plates or --slopes.
-    let rules = brickwright::pipeline::load_rules(None)
-        .expect("the default rules load")
-        .restricted(|p| p.spec().family() == Family::Brick)
-        .expect("brick rules");
-    let outcome = search::build_guided(
-        &model.grid,
-        search::Guide {
-            slant: Some(&model.slant),
-            surface: Some(&model.surface),
-            ..Default::default()
-        },
-        &rules,
-        &SearchOptions::default(),
-    )
-    .expect("a build");
-    let order = search::placements(&outcome);
-    let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
-    a.regroup(StepGrouping::Auto);
-    a
+    brickwright::pipeline::bricks_by_course(&path, studs).expect("the fixture builds")
 }
 
 fn bench(c: &mut Criterion) {

@@ -23,7 +23,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use brickwright::assembly::Assembly;
 use brickwright::ldraw::{read_ldr, to_assembly};
 use brickwright::physics::{analyze, analyze_steps, Params};
 
@@ -47,15 +46,7 @@ fn main() -> Result<()> {
         let begun = Instant::now();
         let (mut agree, mut safe_only, mut missed) = (0, 0, 0);
         for check in &fast.steps {
-            let prefix = Assembly {
-                pieces: asm
-                    .pieces
-                    .iter()
-                    .filter(|p| p.step.0 <= check.step)
-                    .cloned()
-                    .collect(),
-                layer_ldu: asm.layer_ldu,
-            };
+            let prefix = asm.through_step(check.step);
             let full = analyze(&prefix, &params)?;
             match (check.stands, full.stands()) {
                 (a, b) if a == b => agree += 1,

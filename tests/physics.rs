@@ -472,35 +472,10 @@ fn bad_parameters_are_an_error_not_a_panic() {
 /// The search's build of a fixture mesh, searched, sequenced and grouped
 /// as `build` does it (bricks only).
 fn fixture_build(name: &str, studs: u32) -> Assembly {
-    use brickwright::assembly::order::by_course;
-    use brickwright::catalog::Family;
-    use brickwright::search::{self, SearchOptions};
-    use brickwright::voxel::{voxelize, Sizing, VoxelizeOptions};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures")
         .join(name);
-    let mesh = brickwright::mesh::load(&path).expect("fixture loads");
-    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
-    let model = voxelize(&mesh, &opts).expect("fixture voxelizes");
-    let rules = brickwright::pipeline::load_rules(None)
-        .expect("the default rules load")
-        .restricted(|p| p.spec().family() == Family::Brick)
-        .expect("brick rules");
-    let outcome = search::build_guided(
-        &model.grid,
-        search::Guide {
-            slant: Some(&model.slant),
-            surface: Some(&model.surface),
-            ..Default::default()
-        },
-        &rules,
-        &SearchOptions::default(),
-    )
-    .expect("a build");
-    let order = search::placements(&outcome);
-    let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
-    a.regroup(StepGrouping::Auto);
-    a
+    brickwright::pipeline::bricks_by_course(&path, studs).expect("the fixture builds")
 }
 
 /// The step check reuses and certifies what it can; on real builds every
@@ -519,15 +494,7 @@ fn every_step_of_a_real_build_agrees_with_a_full_solve() {
         assert!(fast.complete);
         assert_eq!(fast.steps.len() as u32, asm.step_count(), "{name}");
         for check in &fast.steps {
-            let prefix = Assembly {
-                pieces: asm
-                    .pieces
-                    .iter()
-                    .filter(|p| p.step.0 <= check.step)
-                    .cloned()
-                    .collect(),
-                layer_ldu: asm.layer_ldu,
-            };
+            let prefix = asm.through_step(check.step);
             let full = analyze(&prefix, &params).unwrap();
             assert_eq!(check.stands, full.stands(), "{name} step {}", check.step);
             assert!((0.0..=1.0).contains(&check.min_score), "{name}");

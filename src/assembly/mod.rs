@@ -93,6 +93,20 @@ impl Assembly {
         self.pieces.last().map_or(0, |p| p.step.0)
     }
 
+    /// The build as it stands after step `step`: the pieces of steps
+    /// `1..=step`.
+    pub fn through_step(&self, step: u32) -> Assembly {
+        Assembly {
+            pieces: self
+                .pieces
+                .iter()
+                .filter(|p| p.step.0 <= step)
+                .cloned()
+                .collect(),
+            layer_ldu: self.layer_ldu,
+        }
+    }
+
     /// Regroups the steps. `Auto` (the default) makes a step of each run
     /// of pieces on one brick course, a big run split into balanced steps
     /// of at most [`STEP_PIECES`] pieces, more when that is needed to keep

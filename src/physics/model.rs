@@ -595,38 +595,12 @@ pub(super) fn solve_by(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::order::by_course;
-    use crate::assembly::StepGrouping;
-    use crate::catalog::{Color, Family};
-    use crate::search::{self, SearchOptions};
-    use crate::voxel::{voxelize, Sizing, VoxelizeOptions};
 
     fn fixture_build(name: &str, studs: u32) -> Assembly {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("fixtures")
             .join(name);
-        let mesh = crate::mesh::load(&path).expect("fixture loads");
-        let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
-        let model = voxelize(&mesh, &opts).expect("fixture voxelizes");
-        let rules = crate::pipeline::load_rules(None)
-            .expect("the default rules load")
-            .restricted(|p| p.spec().family() == Family::Brick)
-            .expect("brick rules");
-        let outcome = search::build_guided(
-            &model.grid,
-            search::Guide {
-                slant: Some(&model.slant),
-                surface: Some(&model.surface),
-                ..Default::default()
-            },
-            &rules,
-            &SearchOptions::default(),
-        )
-        .expect("a build");
-        let order = search::placements(&outcome);
-        let mut a = by_course(&Assembly::from_order(&order, 24, Color::RED));
-        a.regroup(StepGrouping::Auto);
-        a
+        crate::pipeline::bricks_by_course(&path, studs).expect("the fixture builds")
     }
 
     fn usages(s: &Structure, n: usize, params: &Params, method: Method) -> Vec<f64> {

@@ -79,3 +79,36 @@ pub(super) fn voxelize(
         labels,
     })
 }
+
+/// The mesh at `path`, `studs` studs across, built in bricks alone (the
+/// default rules), in course order and grouped in steps as `build` groups
+/// them, without the planner's checks and repairs: the structure the force
+/// analysis's tests and benchmarks measure.
+#[doc(hidden)]
+pub fn bricks_by_course(path: &Path, studs: u32) -> anyhow::Result<crate::assembly::Assembly> {
+    use crate::assembly::{order::by_course, Assembly, StepGrouping};
+    use crate::search::{self, SearchOptions};
+    use crate::voxel::{voxelize, Sizing};
+    let mesh = mesh::load(path)?;
+    let opts = VoxelizeOptions::default().with_sizing(Sizing::Studs(studs));
+    let model = voxelize(&mesh, &opts)?;
+    let rules = load_rules(None)?.restricted(|p| p.spec().family() == Family::Brick)?;
+    let outcome = search::build_guided(
+        &model.grid,
+        search::Guide {
+            slant: Some(&model.slant),
+            surface: Some(&model.surface),
+            ..Default::default()
+        },
+        &rules,
+        &SearchOptions::default(),
+    )?;
+    let order = search::placements(&outcome);
+    let mut a = by_course(&Assembly::from_order(
+        &order,
+        24,
+        crate::catalog::Color::RED,
+    ));
+    a.regroup(StepGrouping::Auto);
+    Ok(a)
+}

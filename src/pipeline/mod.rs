@@ -23,7 +23,7 @@ pub mod stability;
 mod write;
 
 pub use error::BuildError;
-pub use input::load_rules;
+pub use input::{bricks_by_course, load_rules};
 pub use options::{BuildOptions, Format, Formats, DEFAULT_STABILITY_BUDGET, SUPPORT_NOTE};
 pub use report::{BuildReport, MeshColorReport, Quality, ReportOptions, StageTimes};
 pub use stability::{Stability, StabilityReport};
