@@ -16,6 +16,7 @@
 //! renderer redraws only where the step changed something.
 
 use image::{Rgb, RgbaImage};
+use rayon::prelude::*;
 
 use super::raster::{PixelRect, Samples, EMPTY};
 
@@ -106,7 +107,10 @@ fn pair(s: &Samples, looks: &[PieceLook], i: usize, j: usize, jump: f32) -> u8 {
     }
 }
 
-/// Composes pixel rectangle `rect` of `out` from `samples`.
+/// Composes pixel rectangle `rect` of `out` from `samples`; a large one
+/// with its rows cut into bands composed in parallel (a pixel depends
+/// only on the samples near it, so a band composed on its own is what
+/// composing the whole rectangle makes of it).
 pub(crate) fn compose(
     samples: &Samples,
     looks: &[PieceLook],
@@ -114,16 +118,83 @@ pub(crate) fn compose(
     rect: PixelRect,
     out: &mut RgbaImage,
 ) {
-    let ss = samples.ss;
-    let (w, h) = (samples.w, samples.h);
     let rect = PixelRect {
         x1: rect.x1.min(out.width()),
         y1: rect.y1.min(out.height()),
         ..rect
     };
-    if rect.is_empty() || w == 0 || h == 0 {
+    if rect.is_empty() || samples.w == 0 || samples.h == 0 {
         return;
     }
+    let width = out.width() as usize;
+    let area = u64::from(rect.x1 - rect.x0) * u64::from(rect.y1 - rect.y0);
+    let rows = if area < BANDED_PIXELS {
+        rect.y1 - rect.y0
+    } else {
+        band_rows(rect.y1 - rect.y0)
+    };
+    let (y0, y1) = (rect.y0 as usize, rect.y1 as usize);
+    let pixels: &mut [u8] = out;
+    pixels[y0 * width * 4..y1 * width * 4]
+        .par_chunks_mut(rows as usize * width * 4)
+        .enumerate()
+        .for_each(|(k, band)| {
+            let top = rect.y0 + k as u32 * rows;
+            let rect = PixelRect {
+                y0: top,
+                y1: top + (band.len() / (width * 4)) as u32,
+                ..rect
+            };
+            compose_rows(
+                samples,
+                looks,
+                style,
+                rect,
+                Rows {
+                    pixels: band,
+                    width,
+                    top,
+                },
+            );
+        });
+}
+
+/// Fewest pixels [`compose`] composes in bands: a smaller rectangle (a
+/// step's few new pieces) is one thread's, while other threads compose
+/// other steps.
+const BANDED_PIXELS: u64 = 100_000;
+
+/// Pixel rows a band of [`compose`] takes: the rows cut in four bands a
+/// thread, at least 16 rows each.
+fn band_rows(rows: u32) -> u32 {
+    rows.div_ceil(4 * rayon::current_num_threads() as u32)
+        .max(16)
+}
+
+/// Rows of an RGBA image from row `top`, `width` pixels each.
+struct Rows<'a> {
+    pixels: &'a mut [u8],
+    width: usize,
+    top: u32,
+}
+
+impl Rows<'_> {
+    fn put(&mut self, x: u32, y: u32, rgba: [u8; 4]) {
+        let i = ((y - self.top) as usize * self.width + x as usize) * 4;
+        self.pixels[i..i + 4].copy_from_slice(&rgba);
+    }
+}
+
+/// Composes pixel rectangle `rect`, which lies within `out`'s rows.
+fn compose_rows(
+    samples: &Samples,
+    looks: &[PieceLook],
+    style: &Style,
+    rect: PixelRect,
+    mut out: Rows<'_>,
+) {
+    let ss = samples.ss;
+    let (w, h) = (samples.w, samples.h);
     let (sx0, sy0) = (rect.x0 as usize * ss, rect.y0 as usize * ss);
     let (sx1, sy1) = (
         (rect.x1 as usize * ss).min(w),
@@ -190,7 +261,7 @@ pub(crate) fn compose(
     for py in rect.y0..rect.y1 {
         for px in rect.x0..rect.x1 {
             if let Some(px_out) = uniform(samples, &lines, (ex0, ey0, ew), (px, py), looks, style) {
-                out.put_pixel(px, py, image::Rgba(px_out));
+                out.put(px, py, px_out);
                 continue;
             }
             let (mut sr, mut sg, mut sb, mut opaque) = (0u32, 0u32, 0u32, 0u32);
@@ -243,7 +314,7 @@ pub(crate) fn compose(
                     ((opaque * 255 + n / 2) / n) as u8,
                 ]
             };
-            out.put_pixel(px, py, image::Rgba(px_out));
+            out.put(px, py, px_out);
         }
     }
 }
@@ -353,4 +424,67 @@ fn max_filter(src: Vec<u8>, w: usize, h: usize, r: usize) -> Vec<u8> {
 /// The line colour of new pieces for an accent colour, or the plain line.
 pub(crate) fn new_line(accent: Option<Rgb<u8>>) -> [u8; 3] {
     accent.map_or(LINE, |c| c.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::camera::{Camera, View};
+    use crate::render::raster::{tests::heap, Light};
+    use crate::render::RenderOptions;
+
+    #[test]
+    fn a_large_rectangle_composed_in_bands_is_the_rectangle_composed_whole() {
+        let scene = heap(60);
+        let opts = RenderOptions::default();
+        let (w, h) = (opts.width, opts.height);
+        let cam = Camera::fit(&View::default(), scene.points(), w, h, opts.margin);
+        let light = Light::for_camera(&cam);
+        let mut samples = Samples::new(w, h, opts.supersample);
+        for i in 0..scene.pieces().len() {
+            samples.draw_piece(&scene, i, &cam, &light);
+        }
+        // New, old and plain pieces: every line weight and fade.
+        let looks: Vec<PieceLook> = scene
+            .pieces()
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PieceLook {
+                rgb: p.color.0,
+                class: [class::NEW, class::OLD, class::PLAIN][i % 3],
+            })
+            .collect();
+        let style = opts.style(&cam);
+        let rect = PixelRect {
+            x0: 3,
+            y0: 5,
+            x1: w - 7,
+            y1: h - 2,
+        };
+        let area = u64::from(rect.x1 - rect.x0) * u64::from(rect.y1 - rect.y0);
+        assert!(area >= BANDED_PIXELS && rect.y1 - rect.y0 > 2 * band_rows(rect.y1 - rect.y0));
+        let blank = RgbaImage::from_pixel(w, h, image::Rgba(style.background));
+        let mut banded = blank.clone();
+        compose(&samples, &looks, &style, rect, &mut banded);
+        let mut whole = blank;
+        let width = whole.width() as usize;
+        compose_rows(
+            &samples,
+            &looks,
+            &style,
+            rect,
+            Rows {
+                pixels: &mut whole,
+                width,
+                top: 0,
+            },
+        );
+        assert!(banded == whole, "the bands' pixels differ from the whole's");
+        let colours: std::collections::BTreeSet<[u8; 4]> = whole.pixels().map(|p| p.0).collect();
+        assert!(
+            colours.len() > 50,
+            "{} colours: too plain a test",
+            colours.len()
+        );
+    }
 }

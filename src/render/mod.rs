@@ -436,7 +436,7 @@ impl RenderOptions {
     }
 
     /// The compositor's settings for images through `camera`.
-    fn style(&self, camera: &Camera) -> Style {
+    pub(crate) fn style(&self, camera: &Camera) -> Style {
         let ss = self.supersample.max(1) as f32;
         let samples = |w: f32| ((w * ss - 2.0) / 2.0).round().max(0.0) as usize;
         let radius = samples(self.line_width);

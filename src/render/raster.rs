@@ -10,6 +10,7 @@
 //! same buffer serves every look of a step.
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::camera::Camera;
 use super::scene::Scene;
@@ -166,43 +167,107 @@ impl Samples {
         camera: &Camera,
         light: &Light,
     ) {
-        let eye = camera.toward_eye();
-        let ss = self.ss as f32;
-        let per_sample = camera.scale() * ss;
-        for t in scene.piece_triangles(index) {
-            if t.normal.dot(eye) <= 1e-4 {
-                continue;
+        let ss = self.ss;
+        let mut band = self.whole();
+        for f in flats(scene, index, camera, light, ss) {
+            band.fill_narrowing(&f, NARROW_ROWS);
+        }
+    }
+
+    /// Draws `pieces` of `scene` in that order, as [`draw_piece`]
+    /// (Self::draw_piece) one after the other would. Many pieces are drawn
+    /// with the rows cut into bands filled in parallel: their triangles
+    /// are projected once, a few hundred pieces at a time, then each band
+    /// takes every triangle in the same order and fills only its own rows,
+    /// so every sample ends as it would drawn whole.
+    pub(crate) fn draw_pieces(
+        &mut self,
+        scene: &Scene,
+        pieces: &[usize],
+        camera: &Camera,
+        light: &Light,
+    ) {
+        if pieces.len() < BANDED_PIECES || self.w == 0 {
+            for &i in pieces {
+                self.draw_piece(scene, i, camera, light);
             }
-            // Depth across the screen follows the triangle's plane, taken
-            // from its world corners: stable even for long slivers, where
-            // barycentric weights lose precision.
-            let [a, b, c] = t.positions;
-            let g = (b - a).cross(c - a);
-            let toward = g.dot(eye);
-            if toward.abs() <= 1e-6 * g.length() {
-                continue;
+            return;
+        }
+        let rows = band_rows(self.h);
+        let (w, ss) = (self.w, self.ss);
+        let bands = self.h.div_ceil(rows);
+        let mut binned: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for chunk in pieces.chunks(256) {
+            let flats: Vec<Flat> = chunk
+                .iter()
+                .flat_map(|&i| flats(scene, i, camera, light, ss))
+                .collect();
+            // Each band's triangles, in drawing order: those whose rows
+            // (give or take a sample) reach into it.
+            binned.iter_mut().for_each(Vec::clear);
+            for (k, f) in flats.iter().enumerate() {
+                let ys = f.p.map(|v| v.y);
+                let lo = ys[0].min(ys[1]).min(ys[2]).floor() - 1.0;
+                let hi = ys[0].max(ys[1]).max(ys[2]).ceil() + 1.0;
+                if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 {
+                    continue;
+                }
+                let first = (lo.max(0.0) as usize / rows).min(bands);
+                let last = (hi as usize / rows).min(bands - 1);
+                for band in &mut binned[first..=last.max(first).min(bands - 1)] {
+                    band.push(k as u32);
+                }
             }
-            let slope =
-                Vec2::new(g.dot(camera.right()), g.dot(camera.down())) / (toward * per_sample);
-            let p = t.positions.map(|v| {
-                let q = camera.project(v);
-                Vec3::new(q.x * ss, q.y * ss, q.z)
-            });
-            let n = t.normal;
-            let q = |c: f32| (c.clamp(-1.0, 1.0) * 127.0).round() as i8 as u8;
-            let face = [q(n.x), q(n.y), q(n.z), light.shade(n)];
-            self.fill(p, slope, index as u32, face);
+            self.depth
+                .par_chunks_mut(rows * w)
+                .zip(self.piece.par_chunks_mut(rows * w))
+                .zip(self.face.par_chunks_mut(rows * w))
+                .enumerate()
+                .zip(&binned)
+                .for_each(|((k, ((depth, piece), face)), mine)| {
+                    let mut band = Band {
+                        w,
+                        y0: k * rows,
+                        y1: k * rows + depth.len() / w,
+                        depth,
+                        piece,
+                        face,
+                    };
+                    for &f in mine {
+                        band.fill_narrowing(&flats[f as usize], NARROW_ROWS);
+                    }
+                });
+        }
+    }
+
+    /// Every row, as one band.
+    fn whole(&mut self) -> Band<'_> {
+        Band {
+            w: self.w,
+            y0: 0,
+            y1: self.h,
+            depth: &mut self.depth,
+            piece: &mut self.piece,
+            face: &mut self.face,
         }
     }
 
     /// Fills one triangle given in sample coordinates (x, y) with depth z,
     /// the depth growing by `slope` per sample along x and y.
+    #[cfg(test)]
     fn fill(&mut self, p: [Vec3; 3], slope: Vec2, piece: u32, face: [u8; 4]) {
-        self.fill_narrowing(p, slope, piece, face, NARROW_ROWS);
+        let f = Flat {
+            p,
+            slope,
+            piece,
+            face,
+        };
+        self.whole().fill_narrowing(&f, NARROW_ROWS);
     }
 
     /// [`fill`](Self::fill), narrowing the rows of triangles wider than
     /// `narrow_rows` samples.
+    #[cfg(test)]
     fn fill_narrowing(
         &mut self,
         p: [Vec3; 3],
@@ -211,7 +276,97 @@ impl Samples {
         face: [u8; 4],
         narrow_rows: usize,
     ) {
-        let [mut a, mut b, c] = p;
+        let f = Flat {
+            p,
+            slope,
+            piece,
+            face,
+        };
+        self.whole().fill_narrowing(&f, narrow_rows);
+    }
+}
+
+/// Fewest pieces [`Samples::draw_pieces`] draws in bands: below, one
+/// thread draws them (the steps' few new pieces, drawn while other
+/// threads draw other steps).
+const BANDED_PIECES: usize = 64;
+
+/// Sample rows a band of [`Samples::draw_pieces`] takes: the rows cut in
+/// two bands a thread, at least 64 rows each.
+fn band_rows(h: usize) -> usize {
+    h.div_ceil(2 * rayon::current_num_threads()).max(64)
+}
+
+/// Rows `y0..y1` of the sample buffers: the buffers' slices of those
+/// rows, indexed from row `y0`.
+struct Band<'a> {
+    w: usize,
+    y0: usize,
+    y1: usize,
+    depth: &'a mut [f32],
+    piece: &'a mut [u32],
+    face: &'a mut [[u8; 4]],
+}
+
+/// A triangle ready to fill: its corners in sample coordinates (x, y)
+/// with depth z, the depth's growth per sample along x and y, and what a
+/// sample it covers keeps.
+struct Flat {
+    p: [Vec3; 3],
+    slope: Vec2,
+    piece: u32,
+    face: [u8; 4],
+}
+
+/// The triangles of piece `index` of `scene` seen through `camera` at
+/// `ss` samples a pixel, faces turned away from the viewer culled.
+fn flats<'a>(
+    scene: &'a Scene,
+    index: usize,
+    camera: &'a Camera,
+    light: &'a Light,
+    ss: usize,
+) -> impl Iterator<Item = Flat> + 'a {
+    let eye = camera.toward_eye();
+    let ss = ss as f32;
+    let per_sample = camera.scale() * ss;
+    scene.piece_triangles(index).iter().filter_map(move |t| {
+        if t.normal.dot(eye) <= 1e-4 {
+            return None;
+        }
+        // Depth across the screen follows the triangle's plane, taken
+        // from its world corners: stable even for long slivers, where
+        // barycentric weights lose precision.
+        let [a, b, c] = t.positions;
+        let g = (b - a).cross(c - a);
+        let toward = g.dot(eye);
+        if toward.abs() <= 1e-6 * g.length() {
+            return None;
+        }
+        let slope = Vec2::new(g.dot(camera.right()), g.dot(camera.down())) / (toward * per_sample);
+        let p = t.positions.map(|v| {
+            let q = camera.project(v);
+            Vec3::new(q.x * ss, q.y * ss, q.z)
+        });
+        let n = t.normal;
+        let q = |c: f32| (c.clamp(-1.0, 1.0) * 127.0).round() as i8 as u8;
+        Some(Flat {
+            p,
+            slope,
+            piece: index as u32,
+            face: [q(n.x), q(n.y), q(n.z), light.shade(n)],
+        })
+    })
+}
+
+impl Band<'_> {
+    /// Fills the band's rows of one triangle given in sample coordinates
+    /// (x, y) with depth z, the depth growing by `slope` per sample along x
+    /// and y, narrowing the rows of triangles wider than `narrow_rows`
+    /// samples.
+    fn fill_narrowing(&mut self, f: &Flat, narrow_rows: usize) {
+        let (slope, piece, face) = (f.slope, f.piece, f.face);
+        let [mut a, mut b, c] = f.p;
         let (za, zx, zy) = (a.z - slope.x * a.x - slope.y * a.y, slope.x, slope.y);
         let area = edge(a.truncate(), b.truncate(), c.truncate());
         if !area.is_finite() || area.abs() < 1e-6 {
@@ -226,9 +381,9 @@ impl Samples {
         let lo = a2.min(b2).min(c2);
         let hi = a2.max(b2).max(c2);
         let x0 = ceil(lo.x - 0.5).max(0.0) as usize;
-        let y0 = ceil(lo.y - 0.5).max(0.0) as usize;
+        let y0 = (ceil(lo.y - 0.5).max(0.0) as usize).max(self.y0);
         let x1 = (floor(hi.x - 0.5) + 1.0).clamp(0.0, self.w as f32) as usize;
-        let y1 = (floor(hi.y - 0.5) + 1.0).clamp(0.0, self.h as f32) as usize;
+        let y1 = ((floor(hi.y - 0.5) + 1.0).clamp(0.0, self.y1 as f32) as usize).min(self.y1);
         if x0 >= x1 || y0 >= y1 {
             return;
         }
@@ -261,7 +416,7 @@ impl Samples {
         let narrow = x1 - x0 > narrow_rows;
         for y in y0..y1 {
             let py = y as f32 + 0.5;
-            let row = y * self.w;
+            let row = (y - self.y0) * self.w;
             // Each edge value is evaluated exactly, in the same order for
             // both triangles of a shared edge (so they see exact negations);
             // a row's covered samples are contiguous, so leave the row once
@@ -385,7 +540,7 @@ pub(crate) fn piece_rect(scene: &Scene, index: usize, camera: &Camera) -> PixelR
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::assembly::Step;
     use crate::render::camera::View;
@@ -405,6 +560,48 @@ mod tests {
             n = scene.add_piece(Rgb([255, 0, 0]), Step(1), near());
         }
         (scene, n, f)
+    }
+
+    /// A heap of `n` overlapping boxes of many sizes and depths, some
+    /// sharing faces (equal depths: the first drawn keeps the sample).
+    pub(crate) fn heap(n: usize) -> Scene {
+        let mut scene = Scene::new();
+        for i in 0..n {
+            let k = i as f32;
+            let lo = Vec3::new(
+                (k * 37.0) % 200.0 - 100.0,
+                (k * 53.0) % 120.0 - 60.0,
+                (k * 11.0) % 90.0 - 45.0,
+            );
+            let size = Vec3::new(10.0 + (k * 7.0) % 40.0, 8.0 + (k * 3.0) % 30.0, 12.0);
+            let rgb = Rgb([(i * 40 % 256) as u8, (i * 90 % 256) as u8, 128]);
+            scene.add_piece(rgb, Step(1 + i as u32 / 10), cuboid(lo, lo + size));
+        }
+        scene
+    }
+
+    #[test]
+    fn pieces_drawn_in_bands_leave_the_samples_drawing_one_by_one_leaves() {
+        let scene = heap(3 * BANDED_PIECES);
+        let cam = Camera::fit(&View::default(), scene.points(), 400, 300, 4);
+        let light = Light::for_camera(&cam);
+        let order: Vec<usize> = (0..scene.pieces().len()).collect();
+        let mut banded = Samples::new(400, 300, 2);
+        banded.draw_pieces(&scene, &order, &cam, &light);
+        let mut single = Samples::new(400, 300, 2);
+        for &i in &order {
+            single.draw_piece(&scene, i, &cam, &light);
+        }
+        // Many bands, many pieces: the test is not trivially one band.
+        assert!(banded.h / band_rows(banded.h) >= 2);
+        assert!(single.piece.iter().filter(|&&p| p != EMPTY).count() > 50_000);
+        assert_eq!(banded.piece, single.piece);
+        assert_eq!(banded.face, single.face);
+        assert!(banded
+            .depth
+            .iter()
+            .zip(&single.depth)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     #[test]

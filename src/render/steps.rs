@@ -323,11 +323,18 @@ impl StepRenderer {
 
     /// Draws the pieces of step number `n` seen through `eye`.
     fn draw_step(&self, samples: &mut Samples, n: usize, eye: &Eye) {
-        if let Some((_, r)) = self.steps.get(n) {
-            for &i in &self.order[r.clone()] {
-                samples.draw_piece(&self.scene, i, &eye.camera, &eye.light);
-            }
-        }
+        self.draw_steps(samples, n..n + 1, eye);
+    }
+
+    /// Draws the pieces of step numbers `steps` seen through `eye`, in
+    /// step order.
+    fn draw_steps(&self, samples: &mut Samples, steps: Range<usize>, eye: &Eye) {
+        let at = |n: usize| self.steps.get(n).map(|(_, r)| r.start);
+        let (Some(from), to) = (at(steps.start), at(steps.end)) else {
+            return;
+        };
+        let pieces = &self.order[from..to.unwrap_or(self.order.len())];
+        samples.draw_pieces(&self.scene, pieces, &eye.camera, &eye.light);
     }
 
     /// The finished model, every piece plain (none faded or highlighted).
@@ -348,9 +355,7 @@ impl StepRenderer {
             Some(f) if f.camera == *self.camera() => f.samples,
             _ => {
                 let mut samples = self.samples();
-                for n in 0..self.steps.len() {
-                    self.draw_step(&mut samples, n, &self.eyes[0]);
-                }
+                self.draw_steps(&mut samples, 0..self.steps.len(), &self.eyes[0]);
                 samples
             }
         };
@@ -534,10 +539,7 @@ impl<'a> StepImages<'a> {
                 }
             }
         };
-        let through = r.eye(n);
-        for m in kept.drawn..=n {
-            r.draw_step(&mut kept.samples, m, through);
-        }
+        r.draw_steps(&mut kept.samples, kept.drawn..n + 1, r.eye(n));
         kept.drawn = n + 1;
         self.kept.insert(0, kept);
     }
