@@ -46,6 +46,7 @@ pub use defaults::{
 pub use numbering::{Numbering, RuleNumbers};
 pub use parse::RuleError;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::catalog::{Family, PartKind};
@@ -236,8 +237,15 @@ impl RuleSet {
             .filter(|r| keep(r.anchor) && keep(r.added))
             .cloned()
             .collect();
-        let set =
-            RuleSet::new(alphabet, starts, rules, self.source.clone())?.with_unseen(self.unseen);
+        // The loaded set's numbers are worked out beside the cut one.
+        let (numbering, set) = rayon::join(
+            || self.numbering(),
+            || {
+                RuleSet::new(alphabet, starts, rules, self.source.clone())
+                    .map(|set| set.with_unseen(self.unseen))
+            },
+        );
+        let set = set?;
         // A complex rule whose heights the new layers cannot express (a
         // plate's offset among bricks) goes with the parts it needs.
         let complex = self
@@ -247,7 +255,7 @@ impl RuleSet {
             .cloned()
             .collect();
         let mut set = set.with_complex(complex)?;
-        set.numbered = Some(Box::new(self.numbering()));
+        set.numbered = Some(Box::new(numbering));
         Ok(set)
     }
 
@@ -336,7 +344,16 @@ impl RuleSet {
     /// The distinct turns of rule `r` (numbered `id`), its weight shared
     /// among them; `None` if its pieces do not stud-connect.
     fn rule_variants(&self, id: RuleId, r: &Rule) -> Option<Vec<Variant>> {
-        let a = self.body(r.anchor, Rot::R0, Cell::new(0, 0, 0));
+        let anchor = self.body(r.anchor, Rot::R0, Cell::new(0, 0, 0));
+        let mut mine = Vec::new();
+        self.rule_variants_into(id, r, &anchor, &mut mine)
+            .then_some(mine)
+    }
+
+    /// [`rule_variants`](Self::rule_variants) added to `out`, given the
+    /// anchor's body at the origin unturned; false (nothing added) if the
+    /// pieces do not stud-connect.
+    fn rule_variants_into(&self, id: RuleId, r: &Rule, a: &Body, out: &mut Vec<Variant>) -> bool {
         let dz = match r.dir {
             Dir::Up => a.bbox.sz,
             Dir::Down => -(r.added.spec().height_ldu() / self.layer_ldu()).max(1),
@@ -344,12 +361,12 @@ impl RuleSet {
         let b0 = self.body(r.added, r.added_rot, Cell::new(r.dx, r.dy, dz));
         let connects = match r.dir {
             Dir::Up => a.holds(&b0),
-            Dir::Down => b0.holds(&a),
+            Dir::Down => b0.holds(a),
         };
         if !connects {
-            return None;
+            return false;
         }
-        let mut mine: Vec<Variant> = Vec::new();
+        let first = out.len();
         for turn in Rot::ALL {
             let ra = a.bbox.turned(turn);
             let rb = b0.bbox.turned(turn);
@@ -363,15 +380,16 @@ impl RuleSet {
                 dir: r.dir,
                 weight: 0.0,
             };
-            if !mine.iter().any(|m| same_geometry(m, &v)) {
-                mine.push(v);
+            if !out[first..].iter().any(|m| same_geometry(m, &v)) {
+                out.push(v);
             }
         }
+        let mine = &mut out[first..];
         let n = mine.len() as f64;
-        for v in &mut mine {
+        for v in mine {
             v.weight = r.weight / n;
         }
-        Some(mine)
+        true
     }
 
     /// The same system with every basic rule the file does not give (every
@@ -398,42 +416,67 @@ impl RuleSet {
             )
         };
         let mut seen: crate::keyhash::KeySet<Key> = self.variants.iter().map(key).collect();
-        let parts = self.alphabet.clone();
-        for &a in &parts {
-            for &b in &parts {
-                for rot in Rot::ALL {
-                    if b.spec().canonical_rot(rot) != rot {
-                        continue;
-                    }
-                    let (ax, ay) = a.spec().footprint(Rot::R0);
-                    let (bx, by) = b.spec().footprint(rot);
-                    for dir in [Dir::Up, Dir::Down] {
-                        for dy in -(by - 1)..ay {
-                            for dx in -(bx - 1)..ax {
-                                let rule = Rule {
-                                    anchor: a,
-                                    added: b,
-                                    added_rot: rot,
-                                    dir,
-                                    dx,
-                                    dy,
-                                    weight: w,
-                                    line: 0,
-                                };
-                                let id = RuleId(self.rules.len() as u32);
-                                let Some(vs) = self.rule_variants(id, &rule) else {
-                                    continue;
-                                };
-                                if vs.iter().any(|v| seen.contains(&key(v))) {
-                                    continue;
+        // Every rule between two parts that connects, with its turns, in
+        // the order the loops make them: made for each anchor in parallel
+        // (turning the rules is most of the work), then kept in that order
+        // unless a turn of it is already a rule's.
+        let parts = &self.alphabet;
+        type Found = (Vec<(Rule, usize)>, Vec<Variant>);
+        let found: Vec<Found> = parts
+            .par_iter()
+            .map(|&a| {
+                let anchor = self.body(a, Rot::R0, Cell::new(0, 0, 0));
+                let (mut rules, mut turns) = (Vec::new(), Vec::new());
+                for &b in parts {
+                    for rot in Rot::ALL {
+                        if b.spec().canonical_rot(rot) != rot {
+                            continue;
+                        }
+                        let (ax, ay) = a.spec().footprint(Rot::R0);
+                        let (bx, by) = b.spec().footprint(rot);
+                        for dir in [Dir::Up, Dir::Down] {
+                            for dy in -(by - 1)..ay {
+                                for dx in -(bx - 1)..ax {
+                                    let rule = Rule {
+                                        anchor: a,
+                                        added: b,
+                                        added_rot: rot,
+                                        dir,
+                                        dx,
+                                        dy,
+                                        weight: w,
+                                        line: 0,
+                                    };
+                                    let before = turns.len();
+                                    if self.rule_variants_into(
+                                        RuleId(0),
+                                        &rule,
+                                        &anchor,
+                                        &mut turns,
+                                    ) {
+                                        rules.push((rule, turns.len() - before));
+                                    }
                                 }
-                                seen.extend(vs.iter().map(key));
-                                self.variants.extend(vs);
-                                self.rules.push(rule);
                             }
                         }
                     }
                 }
+                (rules, turns)
+            })
+            .collect();
+        for (rules, turns) in found {
+            let mut at = 0;
+            for (rule, n) in rules {
+                let vs = &turns[at..at + n];
+                at += n;
+                if vs.iter().any(|v| seen.contains(&key(v))) {
+                    continue;
+                }
+                let id = RuleId(self.rules.len() as u32);
+                seen.extend(vs.iter().map(key));
+                self.variants
+                    .extend(vs.iter().map(|v| Variant { rule: id, ..*v }));
+                self.rules.push(rule);
             }
         }
         self

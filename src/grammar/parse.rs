@@ -182,9 +182,19 @@ impl RuleSet {
             complex.push(r.clone());
         }
         // Checked with this file's name in the messages, then merged.
+        // (Only the alphabet and the layers are needed: not the basic rules'
+        // turns, which are most of a rule set.)
         let alone = RuleSet {
+            alphabet: self.alphabet.clone(),
+            starts: Vec::new(),
+            rules: Vec::new(),
+            explicit: 0,
+            unseen: None,
+            variants: Vec::new(),
+            complex: Vec::new(),
+            complex_variants: Vec::new(),
             source: file,
-            ..self.clone()
+            numbered: None,
         };
         alone.with_complex(found.complex)?;
         self.with_complex(complex)
