@@ -379,7 +379,7 @@ impl<'a> Images<'a> {
                         }
                     }
                 }
-                let mut z = ZlibEncoder::new(Vec::new(), Compression::new(3));
+                let mut z = ZlibEncoder::new(Vec::new(), Compression::new(4));
                 z.write_all(&data)
                     .expect("deflating into memory does not fail");
                 z.finish().expect("deflating into memory does not fail")
