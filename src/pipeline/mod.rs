@@ -87,11 +87,20 @@ fn stage<T>(
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput, BuildError> {
     opts.check()?;
     let mut times = StageTimes::default();
-    // Rules first: a bad rule file should fail before any slow work.
-    let setup = stage(&Silent, "", &mut times.rules, || input::setup(opts))?;
-    let mesh = stage(progress, "loading mesh", &mut times.load, || {
-        input::load(opts)
-    })?;
+    // The rules are made while the mesh loads; a bad rule file is the
+    // error reported when both fail.
+    let (setup, mesh) = std::thread::scope(|s| {
+        let rules = &mut times.rules;
+        let setup = s.spawn(move || stage(&Silent, "", rules, || input::setup(opts)));
+        let mesh = stage(progress, "loading mesh", &mut times.load, || {
+            input::load(opts)
+        });
+        let setup = setup
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e));
+        (setup, mesh)
+    });
+    let (setup, mesh) = (setup?, mesh?);
     let model = stage(progress, "voxelizing", &mut times.voxelize, || {
         input::voxelize(opts, &mesh, &setup.rules)
     })?;
@@ -122,21 +131,36 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
 
     let stem = opts.stem();
     let pictures = pictures::Pictures::of(&settled, &stem, setup.rules.layer_ldu());
-    let rendered = match pictures::wanted(&opts.formats) {
-        Some(steps) => Some(stage(progress, "rendering", &mut times.render, || {
-            Ok(pictures::render_all(&pictures, steps, progress)?)
-        })?),
-        None => None,
-    };
-    let booklet = match &rendered {
-        Some(rendered) if opts.formats.contains(Format::Pdf) => Some(stage(
-            progress,
-            "laying out the booklet",
-            &mut times.booklet,
-            || write::booklet(opts, &pictures, rendered, &setup.template),
-        )?),
-        _ => None,
-    };
+    // The outputs without pictures are made beside the pictures, and the
+    // pictures' PNG files beside the booklet: each pair on its own thread.
+    let (rendered, data) = std::thread::scope(|s| {
+        let data = s.spawn(|| write::data_outputs(opts, &setup.rules, &settled, &pictures));
+        let rendered = match pictures::wanted(&opts.formats) {
+            Some(steps) => stage(progress, "rendering", &mut times.render, || {
+                Ok(Some(pictures::render_all(&pictures, steps, progress)?))
+            }),
+            None => Ok(None),
+        };
+        let data = data.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+        rendered.map(|r| (r, data))
+    })?;
+    let (booklet, encoded) = std::thread::scope(|s| {
+        let encoded = rendered
+            .as_ref()
+            .map(|r| s.spawn(|| write::encode_pictures(opts, r)));
+        let booklet = match &rendered {
+            Some(rendered) if opts.formats.contains(Format::Pdf) => stage(
+                progress,
+                "laying out the booklet",
+                &mut times.booklet,
+                || write::booklet(opts, &pictures, rendered, &setup.template),
+            )
+            .map(Some),
+            _ => Ok(None),
+        };
+        let encoded = encoded.map(|e| e.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+        booklet.map(|b| (b, encoded))
+    })?;
 
     let pages = booklet.as_ref().map(|b| b.pages);
     let mut report = report::compose(
@@ -153,10 +177,10 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutput
     progress.stage("writing");
     let report = write::write(
         opts,
-        &setup.rules,
         &settled,
         &pictures,
-        rendered.as_ref(),
+        data,
+        encoded.as_ref(),
         booklet.as_ref().map(|b| b.pdf.as_slice()),
         report,
     )?;
