@@ -451,6 +451,27 @@ pub static PARTS: &[PartSpec] = &[
         2,
         1.18
     ),
+    // The long slopes that cap a roof's run with half the pieces; their
+    // masses scaled from the 2 x 4 and 3 x 2 ones (no published weight
+    // found).
+    slope!(
+        "4445",
+        "4445",
+        "Slope Brick 45 2 x 8",
+        Shape::Slope,
+        8,
+        2,
+        4.15
+    ),
+    slope!(
+        "3297",
+        "3297",
+        "Slope Brick 33 3 x 4",
+        Shape::Slope,
+        4,
+        3,
+        2.93
+    ),
 ];
 
 #[cfg(test)]

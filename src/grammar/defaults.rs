@@ -31,10 +31,11 @@ use crate::geom::Rot;
 /// The alphabet of the default rule set: the paper's six bricks and the
 /// 2x3, the six plates the issue names, and the slopes (used with
 /// `--plates` and `--slopes`).
-pub const DEFAULT_ALPHABET: [&str; 21] = [
+pub const DEFAULT_ALPHABET: [&str; 23] = [
     "3005", "3004", "3622", "3010", "3003", "3002", "3001", // bricks
     "3024", "3023b", "3623", "3710", "3022", "3020", // plates
     "3040b", "3039", "3038", "3037", "4286", "3298", "3665a", "3660a", // slopes
+    "4445", "3297", // long slopes, for a roof's run
 ];
 
 /// Every brick in the catalog, for `--rules rules/extended.rules`.

@@ -494,7 +494,7 @@ fn the_rule_file_names_the_builds_and_round_trips() {
     }
     assert_eq!(rs.starts().len(), rs.alphabet().len());
     assert!(
-        file.contains("Parts: the 3 the builds used, and 18 more"),
+        file.contains("Parts: the 3 the builds used, and 20 more"),
         "{file}"
     );
     assert_eq!(rs.variants(), l.rule_set().variants());
