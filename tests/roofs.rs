@@ -128,8 +128,9 @@ fn check_roof(path: &Path, studs: u32, min_share: f64) {
     assert_eq!(plain_stairs.capped.top, 0, "bricks cap nothing");
     assert!(slopes(&sloped) >= 10, "{} slopes", slopes(&sloped));
     // Nothing lost: about as much built a piece as with bricks alone (with
-    // slopes a layer is half a brick, so a brick is twice the voxels), and
-    // no more 1x1s.
+    // slopes a layer is half a brick, so a brick is twice the voxels): 89%
+    // on the house at 11 studs, 92-104% on the others (85-91% before the
+    // long slopes); and no more 1x1s.
     let vpp = |a: &Assembly, per_brick: i32| {
         let cells: i32 = a
             .pieces
@@ -140,7 +141,7 @@ fn check_roof(path: &Path, studs: u32, min_share: f64) {
     };
     let (p, q) = (vpp(&plain, 1), vpp(&sloped, 2));
     assert!(
-        q >= 0.85 * p,
+        q >= 0.88 * p,
         "{}: {q:.2} bricks a piece against {p:.2}",
         path.display()
     );
@@ -150,31 +151,35 @@ fn check_roof(path: &Path, studs: u32, min_share: f64) {
 #[test]
 fn the_house_fixture_roof_is_capped() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
-    // 344 of 371 at 24 studs (93%; 338 of 372 before the swaps with the
-    // best yield were tried first, 306 of 378 before the piece budget and
-    // the rests of any length).
-    check_roof(&path, 24, 0.88);
+    // 380 of 415 at 24 studs (92%; 344 of 371 before the long slopes 4445
+    // and 3297, 338 of 372 before the swaps with the best yield were tried
+    // first, 306 of 378 before the piece budget and the rests of any
+    // length).
+    check_roof(&path, 24, 0.9);
 }
 
 #[test]
 fn the_barn_fixture_roof_is_capped() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/barn.obj");
-    // A long roof (24 studs along the ridge, about 32°): 276 of 329 top
-    // stair edges capped (84%; 79-87% over seeds 1-3 on the command line).
-    // Its courses are 2x8 bricks laid across the run, showing a stud or
-    // two at each end; capped brick by brick (a piece added for two
-    // columns) the piece budget ran out: 216 of 293 (74%). A course's
-    // line of them is now capped at once, its sides rows of 2x4 slopes
-    // across the bricks' seams (src/search/cap/line.rs).
-    check_roof(&path, 24, 0.8);
+    // A long roof (24 studs along the ridge, about 32°): 310 of 336 top
+    // stair edges capped (92%; 92 / 87 / 92% over seeds 1-3 on the command
+    // line), with the 2x8 slopes 4445 along its run. Before them, 276 of
+    // 329 (84%): its courses are 2x8 bricks laid across the run, showing a
+    // stud or two at each end; capped brick by brick (a piece added for
+    // two columns) the piece budget ran out at 216 of 293 (74%), and a
+    // course's line of them capped at once (src/search/cap/line.rs) took
+    // rows of 2x4 slopes.
+    check_roof(&path, 24, 0.9);
 }
 
 #[test]
 fn the_house_at_the_papers_size_is_capped() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/house.obj");
     // The paper's house (Figure 6: 43 bricks and 24 slopes) is about 11
-    // studs across: 68 of 71 top stair edges capped (96%; 61 of 71 with
-    // the cheap swaps first, the budget spent before the long sides).
+    // studs across: 62 of 68 top stair edges capped (91%; 88-91% over
+    // seeds 1-3; 68 of 71 before the long slopes, which the layout now
+    // lays itself on the roof's lower courses, 61 of 71 with the cheap
+    // swaps first, the budget spent before the long sides).
     check_roof(&path, 11, 0.9);
 }
 
@@ -184,7 +189,7 @@ fn a_shallow_gable_roof_is_capped() {
     let path = dir.path().join("gable.obj");
     // Walls 3 high, the ridge 2.4 above them over a 4-unit run: about 31°.
     std::fs::write(&path, gable_house(8.0, 10.0, 3.0, 2.4)).unwrap();
-    // Every one of its 240.
+    // 252 of 258 (98%; 240 of 241 before the long slopes).
     check_roof(&path, 20, 0.95);
 }
 
@@ -194,12 +199,10 @@ fn a_steep_gable_roof_is_capped() {
     let path = dir.path().join("gable.obj");
     // Walls 3 high, the ridge 4 above them over a 4-unit run: 45°.
     std::fs::write(&path, gable_house(8.0, 10.0, 3.0, 4.0)).unwrap();
-    // 208 of 290 (72%): every course of a 45° roof is a row of slopes and
-    // the brick behind it, and the piece budget runs out before the ridge
-    // (see src/search/cap/mod.rs); the swaps that cap the most stair columns
-    // for each piece they add go first (132 of 269 before they did). The
-    // weights learned from people's models rarely set a 2x4 slope on
-    // bricks (people stack slopes on slopes), so the layout lays few
-    // slopes itself.
-    check_roof(&path, 20, 0.65);
+    // 276 of 277 (99.6%; 98-99.6% over seeds 1-3): the 2x8 slopes 4445
+    // take a course's whole side for one piece. Before them 208 of 290
+    // (72%): every course of a 45° roof was a row of 2x4 slopes and the
+    // brick behind it, and the piece budget ran out before the ridge (see
+    // src/search/cap/mod.rs).
+    check_roof(&path, 20, 0.95);
 }
