@@ -248,6 +248,138 @@ impl VoxelGrid {
         })
     }
 
+    /// The cells `o` at which every box of `boxes`, moved by `o`, lies
+    /// wholly in filled cells: where a piece whose body is `boxes` at the
+    /// origin fits. Boxes must not reach below the origin on any axis
+    /// (none is found where one does).
+    pub fn fits(&self, boxes: &[CellBox]) -> VoxelGrid {
+        let mut out = VoxelGrid::new(self.nx, self.ny, self.nz);
+        if boxes.is_empty()
+            || boxes
+                .iter()
+                .any(|b| b.min.x < 0 || b.min.y < 0 || b.min.z < 0)
+        {
+            return out;
+        }
+        let wpr = self.words_per_row;
+        let rows = (self.ny * self.nz) as usize;
+        // `row` shifted down by `k` bits (cell x + k to bit x), ANDed into
+        // `acc`.
+        let and_shifted = |acc: &mut [u64], row: &[u64], k: usize| {
+            let (q, r) = (k / 64, k % 64);
+            for (w, a) in acc.iter_mut().enumerate() {
+                let lo = row.get(w + q).copied().unwrap_or(0);
+                let v = if r == 0 {
+                    lo
+                } else {
+                    let hi = row.get(w + q + 1).copied().unwrap_or(0);
+                    (lo >> r) | (hi << (64 - r))
+                };
+                *a &= v;
+            }
+        };
+        out.bits.fill(u64::MAX);
+        // Each box is worn down one axis at a time: along x within each
+        // row, then across rows along y, then across layers along z.
+        let mut xs = vec![0u64; self.bits.len()];
+        let mut ys = vec![0u64; self.bits.len()];
+        for b in boxes {
+            xs.fill(u64::MAX);
+            for i in 0..rows {
+                let (row, acc) = (
+                    &self.bits[i * wpr..(i + 1) * wpr],
+                    &mut xs[i * wpr..(i + 1) * wpr],
+                );
+                for dx in 0..b.sx {
+                    and_shifted(acc, row, (b.min.x + dx) as usize);
+                }
+            }
+            for z in 0..self.nz {
+                for y in 0..self.ny {
+                    let r = self.row(y, z);
+                    let acc = &mut ys[r..r + wpr];
+                    acc.fill(u64::MAX);
+                    for dy in 0..b.sy {
+                        let sy = y + b.min.y + dy;
+                        if sy >= self.ny {
+                            acc.fill(0);
+                            break;
+                        }
+                        let s = self.row(sy, z);
+                        for w in 0..wpr {
+                            acc[w] &= xs[s + w];
+                        }
+                    }
+                }
+            }
+            for z in 0..self.nz {
+                for y in 0..self.ny {
+                    let r = self.row(y, z);
+                    for dz in 0..b.sz {
+                        let sz = z + b.min.z + dz;
+                        if sz >= self.nz {
+                            out.bits[r..r + wpr].fill(0);
+                            break;
+                        }
+                        let s = self.row(y, sz);
+                        for w in 0..wpr {
+                            out.bits[r + w] &= ys[s + w];
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The cells (filled or not) whose neighbour `dz` layers up (down, if
+    /// negative) is empty, or lies above or below the grid.
+    pub fn empty_beside(&self, dz: i32) -> VoxelGrid {
+        let mut out = VoxelGrid::new(self.nx, self.ny, self.nz);
+        let wpr = self.words_per_row;
+        // The bits of a row's cells (no padding).
+        let full: Vec<u64> = (0..wpr)
+            .map(|w| {
+                let n = (self.nx as usize).saturating_sub(w * 64).min(64);
+                if n == 64 {
+                    u64::MAX
+                } else {
+                    (1u64 << n) - 1
+                }
+            })
+            .collect();
+        for z in 0..self.nz {
+            let from = z + dz;
+            for y in 0..self.ny {
+                let r = out.row(y, z);
+                for (w, &mask) in full.iter().enumerate() {
+                    out.bits[r + w] = if from < 0 || from >= self.nz {
+                        mask
+                    } else {
+                        !self.bits[self.row(y, from) + w] & mask
+                    };
+                }
+            }
+        }
+        out
+    }
+
+    /// Keeps the cells filled in both grids (of the same size).
+    pub fn intersect(&mut self, other: &VoxelGrid) {
+        debug_assert_eq!(self.dims(), other.dims());
+        for (a, b) in self.bits.iter_mut().zip(&other.bits) {
+            *a &= b;
+        }
+    }
+
+    /// Fills the cells filled in `other` (of the same size).
+    pub fn unite(&mut self, other: &VoxelGrid) {
+        debug_assert_eq!(self.dims(), other.dims());
+        for (a, b) in self.bits.iter_mut().zip(&other.bits) {
+            *a |= b;
+        }
+    }
+
     /// Linear index of an in-bounds cell (x fastest), for side tables.
     #[inline]
     pub fn index(&self, c: Cell) -> usize {
@@ -295,5 +427,49 @@ mod tests {
             sy: 3,
             sz: 2
         }));
+    }
+
+    #[test]
+    fn fits_finds_every_place_a_body_lies_in_filled_cells() {
+        // A grid wider than a word, filled at random; an L of two boxes
+        // and a long bar: each place compared with testing every box.
+        let mut g = VoxelGrid::new(70, 3, 3);
+        let mut state = 7u64;
+        for c in
+            (0..3).flat_map(|z| (0..3).flat_map(move |y| (0..70).map(move |x| Cell::new(x, y, z))))
+        {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            g.set(c, (state >> 33) % 100 < 85);
+        }
+        let b = |x, y, z, sx, sy, sz| CellBox {
+            min: Cell::new(x, y, z),
+            sx,
+            sy,
+            sz,
+        };
+        for boxes in [
+            vec![b(0, 0, 0, 2, 1, 1), b(1, 0, 1, 1, 2, 1)],
+            vec![b(0, 0, 0, 8, 1, 1)],
+            vec![b(0, 0, 0, 1, 1, 1)],
+        ] {
+            let fit = g.fits(&boxes);
+            let mut n = 0;
+            for z in 0..3 {
+                for y in 0..3 {
+                    for x in 0..70 {
+                        let want = boxes.iter().all(|q| g.all_set(&q.moved(x, y, z)));
+                        assert_eq!(
+                            fit.get(Cell::new(x, y, z)),
+                            want,
+                            "{boxes:?} at {x} {y} {z}"
+                        );
+                        n += usize::from(want);
+                    }
+                }
+            }
+            assert!(n > 0, "{boxes:?} fits somewhere");
+        }
     }
 }

@@ -41,7 +41,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::draw::{Drawn, Draws};
-use super::fit::placeable;
+use super::fit::{air, placeable_in};
 use crate::assembly::Placement;
 use crate::catalog::PartKind;
 use crate::geom::{Body, Cell, CellBox, Rot};
@@ -104,14 +104,110 @@ const MISSES: u32 = 256;
 struct VariantIndex {
     /// The shapes the rules' pieces take.
     shapes: Vec<Shape>,
-    /// Each variant's anchor's and new piece's shape (index in `shapes`).
-    anchor_shape: Vec<usize>,
-    added_shape: Vec<usize>,
     /// The variants (of weight above 0, only those joined where they put
-    /// their pieces) by the shape of their new piece, and of their anchor.
-    by_added: Vec<(usize, Vec<u32>)>,
-    by_anchor: Vec<(usize, Vec<u32>)>,
+    /// their pieces) by the shape of their new piece, and of their anchor:
+    /// each with the other piece's shape and where it lies.
+    by_added: Vec<(usize, Arms)>,
+    by_anchor: Vec<(usize, Arms)>,
 }
+
+/// A rule variant as a list of [`VariantIndex`] holds it, from one of its
+/// pieces: the other piece's shape, and the other's origin less this one's.
+#[derive(Debug, Clone, Copy)]
+struct Arm {
+    variant: u32,
+    other: u32,
+    offset: (i32, i32, i32),
+    /// The rule's direction: [`UP`] or [`DOWN`].
+    dir: u8,
+}
+
+/// The variants of one shape of piece ([`Arm`]s), in runs of the same
+/// other shape and direction, each run with the box its offsets span: a
+/// run whose other pieces could lie nowhere in that box is passed over
+/// whole.
+#[derive(Debug, Clone, Default)]
+struct Arms {
+    arms: Vec<Arm>,
+    runs: Vec<Run>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    other: u32,
+    dir: u8,
+    from: u32,
+    to: u32,
+    /// The least and the greatest offset, on each axis.
+    lo: Cell,
+    hi: Cell,
+}
+
+impl Arms {
+    fn new(mut arms: Vec<Arm>) -> Arms {
+        arms.sort_by_key(|a| (a.other, a.dir, a.variant));
+        let mut runs: Vec<Run> = Vec::new();
+        for (i, a) in arms.iter().enumerate() {
+            let c = Cell::new(a.offset.0, a.offset.1, a.offset.2);
+            match runs.last_mut() {
+                Some(r) if r.other == a.other && r.dir == a.dir => {
+                    r.to = i as u32 + 1;
+                    r.lo = Cell::new(r.lo.x.min(c.x), r.lo.y.min(c.y), r.lo.z.min(c.z));
+                    r.hi = Cell::new(r.hi.x.max(c.x), r.hi.y.max(c.y), r.hi.z.max(c.z));
+                }
+                _ => runs.push(Run {
+                    other: a.other,
+                    dir: a.dir,
+                    from: i as u32,
+                    to: i as u32 + 1,
+                    lo: c,
+                    hi: c,
+                }),
+            }
+        }
+        Arms { arms, runs }
+    }
+
+    fn len(&self) -> usize {
+        self.arms.len()
+    }
+
+    fn run(&self, r: &Run) -> &[Arm] {
+        &self.arms[r.from as usize..r.to as usize]
+    }
+}
+
+/// The least and greatest cell of a set of cells, on each axis.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    lo: Cell,
+    hi: Cell,
+}
+
+impl Span {
+    fn of(c: Cell) -> Span {
+        Span { lo: c, hi: c }
+    }
+
+    fn grow(&mut self, c: Cell) {
+        self.lo = Cell::new(self.lo.x.min(c.x), self.lo.y.min(c.y), self.lo.z.min(c.z));
+        self.hi = Cell::new(self.hi.x.max(c.x), self.hi.y.max(c.y), self.hi.z.max(c.z));
+    }
+
+    /// Whether a place `at` plus an offset of `run` can fall in the span.
+    fn meets(&self, at: Cell, run: &Run) -> bool {
+        at.x + run.hi.x >= self.lo.x
+            && at.x + run.lo.x <= self.hi.x
+            && at.y + run.hi.y >= self.lo.y
+            && at.y + run.lo.y <= self.hi.y
+            && at.z + run.hi.z >= self.lo.z
+            && at.z + run.lo.z <= self.hi.z
+    }
+}
+
+/// A new piece's ways in ([`Trace::matching`]): from above, from below.
+const UP: u8 = 1;
+const DOWN: u8 = 2;
 
 impl VariantIndex {
     fn new(rules: &RuleSet) -> VariantIndex {
@@ -141,23 +237,35 @@ impl VariantIndex {
                 }
             })
             .collect();
-        let group = |of: &[usize]| {
-            let mut m: Vec<(usize, Vec<u32>)> =
+        // From the new piece (`from_added`) or from the anchor.
+        let group = |from_added: bool| {
+            let mut m: Vec<(usize, Vec<Arm>)> =
                 (0..shapes.len()).map(|s| (s, Vec::new())).collect();
             for (i, v) in vars.iter().enumerate() {
                 if v.weight > 0.0 && joined[i] {
-                    m[of[i]].1.push(i as u32);
+                    let (ox, oy, oz) = v.offset;
+                    let (this, other, offset) = if from_added {
+                        (added_shape[i], anchor_shape[i], (-ox, -oy, -oz))
+                    } else {
+                        (anchor_shape[i], added_shape[i], (ox, oy, oz))
+                    };
+                    m[this].1.push(Arm {
+                        variant: i as u32,
+                        other: other as u32,
+                        offset,
+                        dir: if v.dir == Dir::Up { UP } else { DOWN },
+                    });
                 }
             }
             m.retain(|(_, l)| !l.is_empty());
-            m
+            m.into_iter()
+                .map(|(s, l)| (s, Arms::new(l)))
+                .collect::<Vec<_>>()
         };
         VariantIndex {
-            by_added: group(&added_shape),
-            by_anchor: group(&anchor_shape),
+            by_added: group(true),
+            by_anchor: group(false),
             shapes: shapes.clone(),
-            anchor_shape,
-            added_shape,
         }
     }
 
@@ -252,6 +360,8 @@ pub(super) struct Trace<'a> {
     total: usize,
     /// Cells of pending pieces.
     held: VoxelGrid,
+    /// The free cells: left, and no pending piece's.
+    open: VoxelGrid,
     pending: Vec<Placement>,
     pending_set: KeySet<Placement>,
     /// Pieces taken away, in backward order, with the rule and anchor.
@@ -274,6 +384,9 @@ pub(super) struct Trace<'a> {
     /// it, and the parts below (a scratch copy the flood fill empties a
     /// piece's cells in, and fills again).
     built: RefCell<VoxelGrid>,
+    /// The empty cells beside what is built that reach the space beside
+    /// the grid or above it ([`air`]), once found at this node.
+    air: RefCell<Option<VoxelGrid>>,
     /// Shapes of the alphabet's pieces, each turn: what can cover a cell.
     shapes: Vec<Body>,
     /// How many times wider `b` is than tuned: doubled each time a pass
@@ -346,10 +459,11 @@ impl<'a> Trace<'a> {
             book,
             layer: rules.layer_ldu(),
             tuning,
-            left: cells,
+            left: cells.clone(),
             left_count: n,
             total: n,
             held: VoxelGrid::new(nx, ny, nz),
+            open: cells,
             pending: Vec::new(),
             pending_set: KeySet::default(),
             taken: Vec::new(),
@@ -360,6 +474,7 @@ impl<'a> Trace<'a> {
             ground,
             first,
             built: RefCell::new(built),
+            air: RefCell::new(None),
             shapes: coverers(rules),
             widen: 1,
             hash: 0,
@@ -662,6 +777,10 @@ impl<'a> Trace<'a> {
     /// place a new piece may be taken away, with each variant of its
     /// shape; each free place an anchor may stay, with each variant of
     /// its shape), not by trying each rule.
+    ///
+    /// Where a new piece of each shape has a way in is found first, once
+    /// a place (few places do: most are shut in by the voxels left above
+    /// and below), so each rule tried at a place costs a look-up.
     fn matching(&self, node: &Frame, drawn: &KeySet<u32>) -> Vec<u32> {
         let vars = self.rules.variants();
         let ix = &self.index;
@@ -671,104 +790,208 @@ impl<'a> Trace<'a> {
             hit[v as usize] = true;
         }
         let mut found = vec![false; vars.len()];
-        // Whether a new piece at a place can go in from above (or below)
-        // is the same for every rule: found once a place.
-        let ways: RefCell<KeyMap<(Placement, bool), bool>> = RefCell::new(KeyMap::default());
-        let way_in = |b: &Placement, bb: &Body, up: bool| {
-            if let Some(&w) = ways.borrow().get(&(*b, up)) {
-                return w;
-            }
-            let w = self.can_place(bb, &[], up);
-            ways.borrow_mut().insert((*b, up), w);
-            w
-        };
         // For each shape, where it is free (from each free cell) and where
         // a piece of it stays (pending, or below the part): by origin.
         let (nx, ny, nz) = self.left.dims();
-        let mut free_at: Vec<VoxelGrid> = Vec::with_capacity(ix.shapes.len());
-        for &(part, rot) in &ix.shapes {
-            let probe = self.body(&Placement::new(part, Cell::new(0, 0, 0), rot));
-            let key = probe.key();
-            let mut m = VoxelGrid::new(nx, ny, nz);
-            for c in self.left.cells() {
-                let o = c.offset(-key.x, -key.y, -key.z);
-                if !self.held.get(c)
-                    && self.left.in_bounds(o)
-                    && self.free(&probe.moved(o.x, o.y, o.z))
-                {
-                    m.set(o, true);
-                }
-            }
-            free_at.push(m);
-        }
+        let probes: Vec<Body> = ix
+            .shapes
+            .iter()
+            .map(|&(part, rot)| self.body(&Placement::new(part, Cell::new(0, 0, 0), rot)))
+            .collect();
+        let free_at: Vec<VoxelGrid> = probes.iter().map(|p| self.open.fits(p.boxes())).collect();
         let mut stay_at: Vec<Option<VoxelGrid>> = vec![None; ix.shapes.len()];
-        for p in &self.stay {
-            if let Some(i) = ix.shape_index(p.part, p.rot) {
-                if self.left.in_bounds(p.origin) {
-                    stay_at[i]
-                        .get_or_insert_with(|| VoxelGrid::new(nx, ny, nz))
-                        .set(p.origin, true);
+        let mut pending_at: Vec<Option<VoxelGrid>> = vec![None; ix.shapes.len()];
+        for (set, of) in [
+            (&mut stay_at, &self.stay),
+            (&mut pending_at, &self.pending_set),
+        ] {
+            for p in of {
+                if let Some(i) = ix.shape_index(p.part, p.rot) {
+                    if self.left.in_bounds(p.origin) {
+                        set[i]
+                            .get_or_insert_with(|| VoxelGrid::new(nx, ny, nz))
+                            .set(p.origin, true);
+                    }
                 }
             }
         }
         let ok_at = |shape: usize, o: Cell| {
             free_at[shape].get(o) || stay_at[shape].as_ref().is_some_and(|m| m.get(o))
         };
-        for (shape, list) in &ix.by_added {
+        // Where a new piece of each shape has a way in (its cells free or
+        // it is matched, not a piece below): from above in `ways[s][0]`,
+        // from below in `ways[s][1]`, with the span of those places, and
+        // the places as a list.
+        type Ways = [Option<(VoxelGrid, Span)>; 2];
+        let mut ways: Vec<Ways> = vec![[None, None]; ix.shapes.len()];
+        let mut entries: Vec<Vec<(Cell, u8)>> = vec![Vec::new(); ix.shapes.len()];
+        // A piece goes in from above only where the layer over its box is
+        // empty, from below where the one under it is (as [`fit`] has it):
+        // the places where neither is are passed over at once.
+        let (over, under) = {
+            let built = self.built.borrow();
+            (built.empty_beside(1), built.empty_beside(-1))
+        };
+        for (shape, _) in &ix.by_added {
+            let s = *shape;
+            let bx = probes[s].bbox;
+            let mut may = if bx.min.x < 0 || bx.min.y < 0 || bx.min.z < 0 {
+                free_at[s].clone()
+            } else {
+                let layer = |z: i32| CellBox {
+                    min: Cell::new(bx.min.x, bx.min.y, z),
+                    sz: 1,
+                    ..bx
+                };
+                let mut m = over.fits(&[layer(bx.min.z + bx.sz - 1)]);
+                m.unite(&under.fits(&[layer(bx.min.z)]));
+                m.intersect(&free_at[s]);
+                m
+            };
+            if let Some(p) = &pending_at[s] {
+                may.unite(p);
+            }
+            for o in may.cells() {
+                let b = probes[s].moved(o.x, o.y, o.z);
+                let mut w = 0;
+                for (k, (dir, up)) in [(UP, true), (DOWN, false)].into_iter().enumerate() {
+                    if self.can_place(&b, &[], up) {
+                        w |= dir;
+                        match &mut ways[s][k] {
+                            Some((g, span)) => {
+                                g.set(o, true);
+                                span.grow(o);
+                            }
+                            none => {
+                                let mut g = VoxelGrid::new(nx, ny, nz);
+                                g.set(o, true);
+                                *none = Some((g, Span::of(o)));
+                            }
+                        }
+                    }
+                }
+                if w != 0 {
+                    entries[s].push((o, w));
+                }
+            }
+        }
+        let dir_index = |dir: u8| usize::from(dir == DOWN);
+        for (shape, arms) in &ix.by_added {
             for b in self.spots_at(node, ix.shapes[*shape]).iter() {
                 // A place no piece can reach is no rule's.
                 if self.ground_set.contains(b) {
                     continue;
                 }
-                let bb = self.body(b);
-                let (up, down) = (way_in(b, &bb, true), way_in(b, &bb, false));
-                if !up && !down {
+                let w = [UP, DOWN]
+                    .into_iter()
+                    .filter(|&d| {
+                        ways[*shape][dir_index(d)]
+                            .as_ref()
+                            .is_some_and(|(g, _)| g.get(b.origin))
+                    })
+                    .fold(0, |w, d| w | d);
+                if w == 0 {
                     continue;
                 }
-                for &v in list {
-                    let var = &vars[v as usize];
-                    if hit[v as usize] || !(if var.dir == Dir::Up { up } else { down }) {
+                for run in &arms.runs {
+                    if w & run.dir == 0 {
                         continue;
                     }
-                    let (ox, oy, oz) = var.offset;
-                    if ok_at(ix.anchor_shape[v as usize], b.origin.offset(-ox, -oy, -oz)) {
-                        hit[v as usize] = true;
-                        found[v as usize] = true;
+                    for arm in arms.run(run) {
+                        let v = arm.variant as usize;
+                        if hit[v] {
+                            continue;
+                        }
+                        let (ox, oy, oz) = arm.offset;
+                        if ok_at(arm.other as usize, b.origin.offset(ox, oy, oz)) {
+                            hit[v] = true;
+                            found[v] = true;
+                        }
                     }
                 }
             }
         }
-        for (shape, list) in &ix.by_anchor {
+        // Anchors at free places where they may join what is matched, with
+        // a new piece that has a way in: gone over from the anchors' side
+        // or from the new pieces', whichever has fewer pairs to look at.
+        let mut free_spots: Vec<Option<(VoxelGrid, Span)>> = vec![None; ix.shapes.len()];
+        let mut from_anchors = 0usize;
+        for (shape, arms) in &ix.by_anchor {
             for a in self.spots_at(node, ix.shapes[*shape]).iter() {
-                if self.stay.contains(a) {
-                    // Its new pieces are in their own lists, done above.
-                    continue;
+                if !self.stay.contains(a) && self.left.in_bounds(a.origin) {
+                    let o = a.origin;
+                    match &mut free_spots[*shape] {
+                        Some((g, span)) => {
+                            g.set(o, true);
+                            span.grow(o);
+                        }
+                        none => {
+                            let mut g = VoxelGrid::new(nx, ny, nz);
+                            g.set(o, true);
+                            *none = Some((g, Span::of(o)));
+                        }
+                    }
+                    from_anchors += arms.len();
                 }
-                for &v in list {
-                    if hit[v as usize] {
-                        continue;
+            }
+        }
+        let from_added: usize = ix
+            .by_added
+            .iter()
+            .map(|(s, arms)| entries[*s].len() * arms.len())
+            .sum();
+        if from_added < from_anchors {
+            for (shape, arms) in &ix.by_added {
+                for &(o, w) in &entries[*shape] {
+                    for run in &arms.runs {
+                        if w & run.dir == 0 {
+                            continue;
+                        }
+                        let Some((spots, span)) = &free_spots[run.other as usize] else {
+                            continue;
+                        };
+                        if !span.meets(o, run) {
+                            continue;
+                        }
+                        for arm in arms.run(run) {
+                            let v = arm.variant as usize;
+                            let (ox, oy, oz) = arm.offset;
+                            if !hit[v] && spots.get(o.offset(ox, oy, oz)) {
+                                hit[v] = true;
+                                found[v] = true;
+                            }
+                        }
                     }
-                    let var = &vars[v as usize];
-                    let (ox, oy, oz) = var.offset;
-                    let o = a.origin.offset(ox, oy, oz);
-                    let added = ix.added_shape[v as usize];
-                    if !ok_at(added, o) {
-                        continue;
-                    }
-                    let b = Placement::new(var.added, o, var.added_rot);
-                    if self.ground_set.contains(&b) {
-                        continue;
-                    }
-                    if way_in(&b, &self.body(&b), var.dir == Dir::Up) {
-                        hit[v as usize] = true;
-                        found[v as usize] = true;
+                }
+            }
+        } else {
+            for (shape, arms) in &ix.by_anchor {
+                let Some((spots, _)) = &free_spots[*shape] else {
+                    continue;
+                };
+                for a in spots.cells() {
+                    for run in &arms.runs {
+                        let Some((way, span)) = &ways[run.other as usize][dir_index(run.dir)]
+                        else {
+                            continue;
+                        };
+                        if !span.meets(a, run) {
+                            continue;
+                        }
+                        for arm in arms.run(run) {
+                            let v = arm.variant as usize;
+                            let (ox, oy, oz) = arm.offset;
+                            if !hit[v] && way.get(a.offset(ox, oy, oz)) {
+                                hit[v] = true;
+                                found[v] = true;
+                            }
+                        }
                     }
                 }
             }
         }
-        let hit = found;
         (0..vars.len() as u32)
-            .filter(|&v| hit[v as usize])
+            .filter(|&v| found[v as usize])
             .collect()
     }
 
@@ -808,16 +1031,16 @@ impl<'a> Trace<'a> {
 
     /// Whether every cell of `b` is left and not held by a pending piece.
     fn free(&self, b: &Body) -> bool {
-        b.boxes().iter().all(|bx| {
-            (0..bx.sz).all(|dz| {
-                (0..bx.sy).all(|dy| {
-                    (0..bx.sx).all(|dx| {
-                        let c = bx.min.offset(dx, dy, dz);
-                        self.left.get(c) && !self.held.get(c)
-                    })
-                })
-            })
-        })
+        b.boxes().iter().all(|bx| self.open.all_set(bx))
+    }
+
+    /// Sets [`Trace::open`] again over the cells of `b`, from `left` and
+    /// `held`.
+    fn reopen(&mut self, b: &Body) {
+        for c in b.cells() {
+            let on = self.left.get(c) && !self.held.get(c);
+            self.open.set(c, on);
+        }
     }
 
     fn is_pending(&self, p: &Placement) -> bool {
@@ -875,12 +1098,34 @@ impl<'a> Trace<'a> {
     /// what is left of the part besides `b`, and the parts below, leave it
     /// a way in.
     fn can_place(&self, b: &Body, also_gone: &[Body], from_above: bool) -> bool {
+        // The layer beside its box that way must be empty (it passes
+        // through it whether it goes straight or moves about).
+        let bx = b.bbox;
+        let z = if from_above {
+            bx.min.z + bx.sz
+        } else {
+            bx.min.z - 1
+        };
+        let side = CellBox {
+            min: Cell::new(bx.min.x, bx.min.y, z),
+            sz: 1,
+            ..bx
+        };
+        if also_gone.is_empty() && self.built.borrow().any_set(&side) {
+            return false;
+        }
+        // The air outside what is built, found once a node.
+        let mut air_now = self.air.borrow_mut();
+        if also_gone.is_empty() && air_now.is_none() {
+            *air_now = Some(air(&self.built.borrow()));
+        }
+        let air_now = air_now.as_ref().filter(|_| also_gone.is_empty());
         let mut solid = self.built.borrow_mut();
         solid.set_body(b, false);
         for g in also_gone {
             solid.set_body(g, false);
         }
-        let ok = placeable(&b.bbox, &solid, from_above);
+        let ok = placeable_in(&b.bbox, &solid, from_above, air_now);
         solid.set_body(b, true);
         for g in also_gone {
             solid.set_body(g, true);
@@ -1081,6 +1326,7 @@ impl<'a> Trace<'a> {
     }
 
     fn apply(&mut self, c: &Change) {
+        *self.air.get_mut() = None;
         let c_taken = c.taken.clone();
         let mut were = Vec::with_capacity(c_taken.len());
         for a in &c.new_pending {
@@ -1090,6 +1336,7 @@ impl<'a> Trace<'a> {
             self.pending_set.insert(*a);
             self.stay.insert(*a);
             self.hash ^= piece_hash(a, 1);
+            self.open.set_body(&b, false);
         }
         for (p, _) in &c_taken {
             let b = self.body(p);
@@ -1103,6 +1350,7 @@ impl<'a> Trace<'a> {
             }
             were.push(was);
             self.left.set_body(&b, false);
+            self.open.set_body(&b, false);
             self.built.get_mut().set_body(&b, false);
             self.left_count -= b.volume() as usize;
             self.taken.push(*p);
@@ -1113,6 +1361,7 @@ impl<'a> Trace<'a> {
     }
 
     fn undo(&mut self, c: &Change) {
+        *self.air.get_mut() = None;
         let were = self.were_log.pop().unwrap_or_default();
         for ((p, _), was) in c.taken.iter().zip(were).rev() {
             let b = self.body(p);
@@ -1128,6 +1377,7 @@ impl<'a> Trace<'a> {
                 self.held.set_body(&b, true);
                 self.hash ^= piece_hash(p, 1);
             }
+            self.reopen(&b);
         }
         for a in c.new_pending.iter().rev() {
             let b = self.body(a);
@@ -1136,6 +1386,7 @@ impl<'a> Trace<'a> {
             self.pending_set.remove(a);
             self.stay.remove(a);
             self.hash ^= piece_hash(a, 1);
+            self.reopen(&b);
         }
     }
 

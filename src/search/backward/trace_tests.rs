@@ -223,4 +223,40 @@ fn listing_the_rules_that_match_agrees_with_trying_each() {
     t.apply(&c);
     let frame = t.frame(&mut rng, &count, None);
     check(&t, &frame, "box, second node");
+    // With slopes (layers half a brick high, 61,000 rule variants, most of
+    // them joints people never made): a gabled block of 6 x 4 studs, two
+    // courses and a ridge, at every node down a path of drawn matches.
+    let rules = crate::grammar::default_rules()
+        .restricted(|p| p.spec().family() != crate::catalog::Family::Plate)
+        .unwrap();
+    let book = RuleBook::new(&rules);
+    let mut grid = VoxelGrid::new(6, 4, 6);
+    for z in 0..6 {
+        for y in 0..4 {
+            for x in 0..6 {
+                // Walls four layers high, then a ridge two layers high.
+                if z < 4 || (1..3).contains(&y) {
+                    grid.set(Cell::new(x, y, z), true);
+                }
+            }
+        }
+    }
+    let below = VoxelGrid::new(6, 4, 6);
+    let mut t = Trace::new(&rules, &book, tuning(), grid, &below, &[], true);
+    let mut steps = 0;
+    for i in 0..12 {
+        let frame = t.frame(&mut rng, &count, None);
+        check(&t, &frame, &format!("slopes, node {i}"));
+        let listed = t.matching(&frame, &KeySet::default());
+        let Some(c) = listed
+            .iter()
+            .rev()
+            .find_map(|&v| t.match_basic(v, &frame, 0).map(|(c, _)| c))
+        else {
+            break;
+        };
+        t.apply(&c);
+        steps += 1;
+    }
+    assert!(steps >= 8, "{steps} steps");
 }
