@@ -87,61 +87,39 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
     let mut seen: HashSet<VariantKey> = HashSet::new();
     for &a in &parts {
         for &b in &parts {
-            let rots = Rot::ALL
-                .into_iter()
-                .filter(|&r| b.spec().canonical_rot(r) == r);
-            for rot in rots {
-                for dir in [Dir::Up, Dir::Down] {
-                    let (ax, ay) = a.spec().footprint(Rot::R0);
-                    let (bx, by) = b.spec().footprint(rot);
-                    for dy in -(by - 1)..ay {
-                        for dx in -(bx - 1)..ax {
-                            let rule = Rule {
-                                anchor: a,
-                                added: b,
-                                added_rot: rot,
-                                dir,
-                                dx,
-                                dy,
-                                weight: 1.0,
-                                line: 0,
-                            };
-                            // Slopes connect on part of their top or bottom
-                            // only: skip offsets where no stud meets.
-                            let Ok(one) = RuleSet::new(
-                                parts.clone(),
-                                vec![],
-                                vec![rule.clone()],
-                                String::new(),
-                            ) else {
-                                continue;
-                            };
-                            let keys: Vec<_> = one
-                                .variants()
-                                .iter()
-                                .map(|v| {
-                                    (
-                                        v.anchor,
-                                        v.anchor_rot,
-                                        v.added,
-                                        v.added_rot,
-                                        v.offset,
-                                        v.dir,
-                                    )
-                                })
-                                .collect();
-                            if keys.iter().any(|k| seen.contains(k)) {
-                                continue;
-                            }
-                            seen.extend(keys);
-                            let side = if dir == Dir::Up { 1.0 } else { 0.5 };
-                            let studs = b.spec().studs() as f64;
-                            let weight =
-                                studs * studs * joint_factor((ax, ay), (dx, dy), (bx, by)) * side;
-                            rules.push(Rule { weight, ..rule });
-                        }
-                    }
+            for rule in Rule::every_between(a, b, 1.0) {
+                let (ax, ay) = a.spec().footprint(Rot::R0);
+                let (bx, by) = b.spec().footprint(rule.added_rot);
+                let (dir, dx, dy) = (rule.dir, rule.dx, rule.dy);
+                // Slopes connect on part of their top or bottom
+                // only: skip offsets where no stud meets.
+                let Ok(one) =
+                    RuleSet::new(parts.clone(), vec![], vec![rule.clone()], String::new())
+                else {
+                    continue;
+                };
+                let keys: Vec<_> = one
+                    .variants()
+                    .iter()
+                    .map(|v| {
+                        (
+                            v.anchor,
+                            v.anchor_rot,
+                            v.added,
+                            v.added_rot,
+                            v.offset,
+                            v.dir,
+                        )
+                    })
+                    .collect();
+                if keys.iter().any(|k| seen.contains(k)) {
+                    continue;
                 }
+                seen.extend(keys);
+                let side = if dir == Dir::Up { 1.0 } else { 0.5 };
+                let studs = b.spec().studs() as f64;
+                let weight = studs * studs * joint_factor((ax, ay), (dx, dy), (bx, by)) * side;
+                rules.push(Rule { weight, ..rule });
             }
         }
     }

@@ -96,6 +96,41 @@ pub struct Rule {
     pub line: usize,
 }
 
+impl Rule {
+    /// Every rule putting `added` against `anchor`, weighing `weight`: each
+    /// of `added`'s distinct turns, on top and underneath, at every offset
+    /// where their footprints overlap, in that order (the order of the
+    /// generated and the unseen rules). Whether the two then stud-connect
+    /// is the rule set's to say.
+    pub(crate) fn every_between(
+        anchor: PartKind,
+        added: PartKind,
+        weight: f64,
+    ) -> impl Iterator<Item = Rule> {
+        let (ax, ay) = anchor.spec().footprint(Rot::R0);
+        Rot::ALL
+            .into_iter()
+            .filter(move |&r| added.spec().canonical_rot(r) == r)
+            .flat_map(move |rot| {
+                let (bx, by) = added.spec().footprint(rot);
+                [Dir::Up, Dir::Down].into_iter().flat_map(move |dir| {
+                    (-(by - 1)..ay).flat_map(move |dy| {
+                        (-(bx - 1)..ax).map(move |dx| Rule {
+                            anchor,
+                            added,
+                            added_rot: rot,
+                            dir,
+                            dx,
+                            dy,
+                            weight,
+                            line: 0,
+                        })
+                    })
+                })
+            })
+    }
+}
+
 /// A starting rule `ε -> P`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StartRule {
@@ -427,38 +462,10 @@ impl RuleSet {
             .map(|&a| {
                 let anchor = self.body(a, Rot::R0, Cell::new(0, 0, 0));
                 let (mut rules, mut turns) = (Vec::new(), Vec::new());
-                for &b in parts {
-                    for rot in Rot::ALL {
-                        if b.spec().canonical_rot(rot) != rot {
-                            continue;
-                        }
-                        let (ax, ay) = a.spec().footprint(Rot::R0);
-                        let (bx, by) = b.spec().footprint(rot);
-                        for dir in [Dir::Up, Dir::Down] {
-                            for dy in -(by - 1)..ay {
-                                for dx in -(bx - 1)..ax {
-                                    let rule = Rule {
-                                        anchor: a,
-                                        added: b,
-                                        added_rot: rot,
-                                        dir,
-                                        dx,
-                                        dy,
-                                        weight: w,
-                                        line: 0,
-                                    };
-                                    let before = turns.len();
-                                    if self.rule_variants_into(
-                                        RuleId(0),
-                                        &rule,
-                                        &anchor,
-                                        &mut turns,
-                                    ) {
-                                        rules.push((rule, turns.len() - before));
-                                    }
-                                }
-                            }
-                        }
+                for rule in parts.iter().flat_map(|&b| Rule::every_between(a, b, w)) {
+                    let before = turns.len();
+                    if self.rule_variants_into(RuleId(0), &rule, &anchor, &mut turns) {
+                        rules.push((rule, turns.len() - before));
                     }
                 }
                 (rules, turns)
