@@ -177,6 +177,9 @@ fn repair_props_the_gallows_arm_with_a_support_column() {
         .unwrap()
         .to_rgba8();
     assert_eq!(red_pixels(&img), 0, "no red on the model");
+    // The picture's usages: the finished model's force program, solved
+    // once after the repairs (their checks ask only for verdicts).
+    assert_eq!(st["stress_map"], "program", "{st}");
     // The booklet says what the column's step is for.
     if tool("pdftotext", "poppler-utils") {
         let text = Command::new("pdftotext")

@@ -162,8 +162,8 @@ use crate::catalog::PartSpec;
 use crate::assembly::Assembly;
 
 pub use steps::{
-    analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_with_finished,
-    analyze_steps_within,
+    analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_verdicts,
+    analyze_steps_with_finished, analyze_steps_within, Finish, PROGRAM_GROWTH,
 };
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
@@ -411,6 +411,39 @@ pub struct StepsAnalysis {
     /// check stopped at a failure before the end.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub finished: Option<Analysis>,
+    /// Where `last`'s usages come from.
+    pub map: StressMap,
+}
+
+/// Where a structure's usages (its stress map) come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StressMap {
+    /// The force program of every group (one answer: see the module docs).
+    Program,
+    /// The equilibria that certified each group at its last step (see
+    /// [`analyze_steps_verdicts`]), and the program's answer for a group
+    /// that failed: within every capacity where the structure stands, but
+    /// one of many.
+    Certificates,
+}
+
+impl StepsAnalysis {
+    /// Takes `finished`, the force program's analysis of the finished
+    /// model, as the map of a check that went to its end (`last`, and the
+    /// last step's row, as [`analyze_steps`] has them); a check that
+    /// stopped before the end is left as it is. False when not taken.
+    pub fn take_map(&mut self, finished: &Analysis) -> bool {
+        if !self.complete || finished.pieces.len() != self.last.pieces.len() {
+            return false;
+        }
+        if let Some(row) = self.steps.last_mut() {
+            *row = steps::check(row.step, &finished.pieces);
+        }
+        self.last = finished.clone();
+        self.map = StressMap::Program;
+        true
+    }
 }
 
 /// Why an analysis failed.

@@ -14,7 +14,9 @@ use super::certify::{Certifier, Verdict};
 use super::compression;
 use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
 use super::model::{solve, Contact, Structure};
-use super::{weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis};
+use super::{
+    weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis, StressMap,
+};
 
 /// How a job's answer was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,7 +36,7 @@ type Answer = (Vec<PieceStress>, Found, f64);
 /// number to this power (interior-point iterations on a 3D-like structure,
 /// each a sparse factorization: measured on bunny builds of 623 to 3,625
 /// pieces).
-const GROWTH: f64 = 2.3;
+pub const PROGRAM_GROWTH: f64 = 2.3;
 
 /// The time to keep, before a deadline, for the analysis of the finished
 /// model that a check cut short leaves to make (by the deadline less that
@@ -64,7 +66,7 @@ impl Reserve {
             Some((n, secs)) if 4 * n >= self.total => (n, secs),
             _ => return deadline,
         };
-        let mut keep = secs * (self.total as f64 / n as f64).powf(GROWTH);
+        let mut keep = secs * (self.total as f64 / n as f64).powf(PROGRAM_GROWTH);
         if when == Finishing::Alongside {
             keep = (keep - start.elapsed().as_secs_f64()).max(0.0);
         }
@@ -242,6 +244,7 @@ pub fn analyze_steps_told(
         deadline,
         from,
         tell,
+        map: true,
     };
     check_steps(&ask, Finish::WhenDue)
 }
@@ -280,8 +283,46 @@ pub fn analyze_steps_with_finished(
         deadline,
         from,
         tell,
+        map: true,
     };
     check_steps(&ask, known.map_or(Finish::Alongside, Finish::Known))
+}
+
+/// The verdict of every step, as [`analyze_steps_told`] gives it, for a
+/// caller that makes the finished model's map itself (once, where a
+/// repair checks a build several times): a complete check solves no
+/// structure for its map, and its [`StepsAnalysis::last`] is drawn from
+/// the equilibria that certified each group at its last step (the
+/// programs' answers for groups that failed), as [`StepsAnalysis::map`]
+/// says. A check cut short by the deadline still has the finished
+/// model's program (no certificate covers it), and one that has the
+/// finished model's analysis from `finish` takes it.
+pub fn analyze_steps_verdicts(
+    assembly: &Assembly,
+    params: &Params,
+    stop_at_first_failure: bool,
+    deadline: Option<Instant>,
+    from: u32,
+    tell: Option<&dyn Fn(u64, u64)>,
+    finish: Finish,
+) -> Result<StepsAnalysis, PhysicsError> {
+    if let Finish::Known(a) = finish {
+        if a.pieces.len() != assembly.pieces.len() {
+            return Err(PhysicsError::Bug(
+                "the finished model's analysis given is of another assembly".into(),
+            ));
+        }
+    }
+    let ask = Ask {
+        assembly,
+        params,
+        stop_at_first_failure,
+        deadline,
+        from,
+        tell,
+        map: false,
+    };
+    check_steps(&ask, finish)
 }
 
 /// What a step check is asked to do (see [`analyze_steps_told`]).
@@ -292,11 +333,14 @@ struct Ask<'a> {
     deadline: Option<Instant>,
     from: u32,
     tell: Option<&'a dyn Fn(u64, u64)>,
+    /// A complete check solves the structure it ends at for its map
+    /// (else the map is the certificates', see [`analyze_steps_verdicts`]).
+    map: bool,
 }
 
 /// When a step check makes the finished model's analysis.
 #[derive(Debug, Clone, Copy)]
-enum Finish<'a> {
+pub enum Finish<'a> {
     /// Alongside the steps, from the start.
     Alongside,
     /// Alongside the steps once it is due: when the check would otherwise
@@ -488,6 +532,7 @@ fn check_steps_in(
         deadline,
         from,
         tell,
+        map,
     } = *ask;
     let n = assembly.pieces.len();
     // (step number, end of its pieces in build order).
@@ -666,8 +711,14 @@ fn check_steps_in(
     solves += usize::from(fin.made);
     // A complete check has found the last step's groups already, most of
     // them exactly: only the others are solved again.
-    let (last, last_seconds) = match &finished {
-        Some((whole, secs)) if end == n => (whole.clone(), *secs),
+    let (last, last_seconds, drawn) = match &finished {
+        Some((whole, secs)) if end == n => (whole.clone(), *secs, StressMap::Program),
+        // The verdicts only: the map of the certificates that gave them.
+        _ if complete && !map => (
+            current[..end].to_vec(),
+            step_seconds,
+            StressMap::Certificates,
+        ),
         _ => {
             let known = complete.then_some((&current[..end], &exact[..end]));
             let begun = Instant::now();
@@ -680,7 +731,7 @@ fn check_steps_in(
             } else {
                 step_seconds
             };
-            (last, secs)
+            (last, secs, StressMap::Program)
         }
     };
     if !complete && first_failure.is_none() && last.iter().any(PieceStress::fails) {
@@ -704,11 +755,12 @@ fn check_steps_in(
         whole_certified: cert.found[cert.found.len() - 1],
         complete,
         finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
+        map: drawn,
     })
 }
 
 /// The check of one intermediate build from its pieces' stress.
-fn check(step: u32, placed: &[PieceStress]) -> StepCheck {
+pub(super) fn check(step: u32, placed: &[PieceStress]) -> StepCheck {
     StepCheck {
         step,
         min_score: placed.iter().map(|p| p.score).fold(1.0, f64::min),
@@ -743,14 +795,17 @@ mod tests {
         // Twice the pieces: 2 s * 2^2.3 = 9.85 s kept.
         let cut = r.cut(deadline, start, Finishing::After).unwrap();
         let kept = (end - cut).as_secs_f64();
-        assert!((kept - 2.0 * 2f64.powf(GROWTH)).abs() < 1e-6, "{kept}");
+        assert!(
+            (kept - 2.0 * 2f64.powf(PROGRAM_GROWTH)).abs() < 1e-6,
+            "{kept}"
+        );
         // Made alongside the check, started 5 s ago: what is left of it is
         // kept.
         let earlier = start.checked_sub(Duration::from_secs(5)).unwrap();
         let cut = r.cut(deadline, earlier, Finishing::Alongside).unwrap();
         let kept = (end - cut).as_secs_f64();
         assert!(
-            (kept - (2.0 * 2f64.powf(GROWTH) - 5.0)).abs() < 0.5,
+            (kept - (2.0 * 2f64.powf(PROGRAM_GROWTH) - 5.0)).abs() < 0.5,
             "{kept}"
         );
         // More than the time there is: the check stops at once.

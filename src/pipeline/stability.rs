@@ -29,8 +29,8 @@ use crate::catalog::Color;
 use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
-    analyze, analyze_steps_from, analyze_steps_with_finished, analyze_steps_within, Analysis,
-    Ground, Params, PhysicsError, StepsAnalysis,
+    analyze, analyze_steps_verdicts, Analysis, Finish, Ground, Params, PhysicsError, StepsAnalysis,
+    StressMap,
 };
 use crate::search::SearchOutcome;
 
@@ -166,6 +166,12 @@ pub struct StabilityReport {
     /// Of those, the groups whose change took the program of the whole
     /// group (no region near the new pieces had one).
     pub whole_certified: usize,
+    /// Where the finished model's usages (`min_score`, `max_usage`,
+    /// `weakest`, the stress picture) come from: `program`, the force
+    /// program with one answer; `certificates`, the equilibria that
+    /// certified its groups at the last step, when that program would not
+    /// have ended within the budget.
+    pub stress_map: StressMap,
 }
 
 /// A planned build: the search's outcome and its verified, grouped
@@ -200,6 +206,7 @@ pub fn settle(
         tell,
         None,
     )?;
+    let cost = MapCost::of(&first);
     let before = Before {
         first_failure: first.check.first_failure,
         min_score: first.finished.as_ref().map_or(0.0, |f| f.min_score),
@@ -314,7 +321,18 @@ pub fn settle(
         }
     }
     // A check that stopped at its first failure: the rest of it.
-    check_the_rest(&mut best, params, deadline, &mut counts)?;
+    check_the_rest(&mut best, params, deadline, &cost, &mut counts)?;
+    // The finished model's map, once: its program's, unless that would not
+    // end by the deadline.
+    let stress_map = map_finished(
+        &mut best.check,
+        &mut best.finished,
+        &best.plan.1,
+        params,
+        deadline,
+        &cost,
+        &mut counts,
+    )?;
     let mut on_baseplate = None;
     if best.check.first_failure.is_some()
         && params.ground == Ground::Table
@@ -326,7 +344,15 @@ pub fn settle(
             ground: Ground::Baseplate,
             ..*params
         };
-        let c = analyze_steps_within(&best.plan.1, &base, true, Some(deadline))?;
+        let c = analyze_steps_verdicts(
+            &best.plan.1,
+            &base,
+            true,
+            Some(deadline),
+            1,
+            None,
+            Finish::WhenDue,
+        )?;
         counts.add(&c);
         on_baseplate = c.complete.then_some(c.first_failure.is_none());
     }
@@ -350,6 +376,7 @@ pub fn settle(
         repaired.then_some(before),
         on_baseplate,
         counts,
+        stress_map,
     );
     Ok((plan, report, check.last))
 }
@@ -466,14 +493,14 @@ fn attempt(
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     let mut plan = plan;
     // The finished model is analysed alongside the steps, unless known.
-    let mut check = analyze_steps_with_finished(
+    let mut check = analyze_steps_verdicts(
         &plan.1,
         params,
         repair,
         Some(deadline),
         1,
         tell,
-        finished.as_ref(),
+        finished.as_ref().map_or(Finish::Alongside, Finish::Known),
     )?;
     counts.add(&check);
     let mut partial = stopped_early(&plan.1, &check);
@@ -499,7 +526,15 @@ fn attempt(
             counts.solves += r.solves;
             counts.certified += r.certified;
             if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
-                let c = analyze_steps_within(&r.assembly, params, true, Some(deadline))?;
+                let c = analyze_steps_verdicts(
+                    &r.assembly,
+                    params,
+                    true,
+                    Some(deadline),
+                    1,
+                    None,
+                    Finish::WhenDue,
+                )?;
                 counts.add(&c);
                 if c.complete && later(c.first_failure, check.first_failure) {
                     order_fix = Some(r.moved);
@@ -562,6 +597,7 @@ fn check_the_rest(
     best: &mut Attempt,
     params: &Params,
     deadline: Instant,
+    cost: &MapCost,
     counts: &mut Counts,
 ) -> Result<(), crate::pipeline::BuildError> {
     if !best.partial {
@@ -571,16 +607,22 @@ fn check_the_rest(
         return Ok(());
     };
     if Instant::now() < deadline {
-        // The finished model's analysis, known or made alongside: a check
-        // cut short by the deadline does not make it again.
-        let mut c = analyze_steps_with_finished(
+        // The finished model's analysis, known, or made alongside when it
+        // ends by the deadline (else its map is the certificates'): a
+        // check cut short by the deadline does not make it again.
+        let finish = match &best.finished {
+            Some(known) => Finish::Known(known),
+            None if cost.fits(best.plan.1.pieces.len(), deadline) => Finish::Alongside,
+            None => Finish::WhenDue,
+        };
+        let mut c = analyze_steps_verdicts(
             &best.plan.1,
             params,
             false,
             Some(deadline),
             from,
             None,
-            best.finished.as_ref(),
+            finish,
         )?;
         counts.add(&c);
         if best.finished.is_none() {
@@ -596,6 +638,75 @@ fn check_the_rest(
     best.check.complete = false;
     best.partial = false;
     Ok(())
+}
+
+/// What the finished model's force program is expected to take, from the
+/// first one solved (the plan's, alongside its check).
+struct MapCost {
+    pieces: usize,
+    seconds: f64,
+}
+
+impl MapCost {
+    fn of(first: &Attempt) -> MapCost {
+        MapCost {
+            pieces: first.plan.1.pieces.len(),
+            seconds: first.finished.as_ref().map_or(0.0, |f| f.solve_seconds),
+        }
+    }
+
+    /// The seconds for a model of `pieces` (growing as the programs do,
+    /// see [`crate::physics::PROGRAM_GROWTH`]).
+    fn seconds(&self, pieces: usize) -> f64 {
+        if self.pieces == 0 {
+            return 0.0;
+        }
+        let ratio = pieces as f64 / self.pieces as f64;
+        self.seconds * ratio.powf(crate::physics::PROGRAM_GROWTH)
+    }
+
+    /// Whether the program of a model of `pieces` ends by `deadline`.
+    fn fits(&self, pieces: usize, deadline: Instant) -> bool {
+        let secs = self.seconds(pieces);
+        secs.is_finite()
+            && Duration::try_from_secs_f64(secs)
+                .ok()
+                .and_then(|d| Instant::now().checked_add(d))
+                .is_some_and(|end| end < deadline)
+    }
+}
+
+/// Gives `check`, complete, of `assembly`, the finished model's map from
+/// the force program, once: `finished` when made already, else made now
+/// (and kept there) when it ends by `deadline` (see [`MapCost`]); else
+/// the map stays the certificates'. Returns where the map comes from.
+fn map_finished(
+    check: &mut StepsAnalysis,
+    finished: &mut Option<Analysis>,
+    assembly: &Assembly,
+    params: &Params,
+    deadline: Instant,
+    cost: &MapCost,
+    counts: &mut Counts,
+) -> Result<StressMap, crate::pipeline::BuildError> {
+    let n = assembly.pieces.len();
+    if check.map == StressMap::Program || check.last.pieces.len() != n {
+        return Ok(check.map);
+    }
+    let made = match finished {
+        Some(f) => f,
+        None if cost.fits(n, deadline) => {
+            counts.solves += 1;
+            finished.insert(analyze(assembly, params)?)
+        }
+        None => return Ok(StressMap::Certificates),
+    };
+    if !check.take_map(made) {
+        return Err(
+            PhysicsError::Bug("the finished model's map is of another build".into()).into(),
+        );
+    }
+    Ok(StressMap::Program)
 }
 
 /// The columns' footprints in words: "3 of 2 x 2, 1 of 1 x 1".
@@ -676,7 +787,15 @@ fn support(
         }
         // Steps before the first column stand as they did.
         let from = first_change(asm, &shored.assembly);
-        let mut c = analyze_steps_from(&shored.assembly, params, true, Some(deadline), from)?;
+        let mut c = analyze_steps_verdicts(
+            &shored.assembly,
+            params,
+            true,
+            Some(deadline),
+            from,
+            None,
+            Finish::WhenDue,
+        )?;
         counts.add(&c);
         // Out of time part way: the columns are still kept if the steps
         // checked stand further than before (the report then says the
@@ -694,9 +813,14 @@ fn support(
             .map(|m| renumbered(m, asm, &shored.assembly, &supports));
         let partial = stopped_early(&shored.assembly, &c);
         // The finished model's analysis, when the check made it: `last`
-        // has every piece, or it was made alongside the steps.
+        // is its program's (a check cut short), or it was made alongside
+        // the steps.
         let whole = c.last.pieces.len() == shored.assembly.pieces.len();
-        let finished = c.finished.take().or_else(|| whole.then(|| c.last.clone()));
+        let program = whole && c.map == StressMap::Program;
+        let finished = c
+            .finished
+            .take()
+            .or_else(|| program.then(|| c.last.clone()));
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: spliced(&best.check, from, c),
@@ -794,6 +918,7 @@ fn report(
     before: Option<Before>,
     stands_on_baseplate: Option<bool>,
     counts: Counts,
+    stress_map: StressMap,
 ) -> StabilityReport {
     let finished = &check.last;
     StabilityReport {
@@ -828,6 +953,7 @@ fn report(
         reused: counts.reused,
         certified: counts.certified,
         whole_certified: counts.whole_certified,
+        stress_map,
     }
 }
 
@@ -987,6 +1113,93 @@ mod tests {
     use super::*;
     use crate::catalog::PartKind;
     use crate::geom::{Cell, Rot};
+
+    /// A 1x4 base, a 1x2 counterweight on its one end and a 1x6 clutched
+    /// to its other end, hanging past it: it stands, on clutch.
+    fn counterweighted() -> Assembly {
+        let at = |id: &str, x, z| {
+            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
+        };
+        let order = [at("3010", 0, 0), at("3004", 0, 1), at("3009", 3, 1)];
+        Assembly::from_order(&order, 24, Color::RED)
+    }
+
+    #[test]
+    fn the_finished_models_map_is_the_programs_once_or_the_certificates_past_the_budget() {
+        let params = Params::default();
+        let asm = counterweighted();
+        let whole = analyze(&asm, &params).unwrap();
+        assert!(whole.stands() && whole.max_usage > 0.0, "{whole:?}");
+        let verdicts = || {
+            analyze_steps_verdicts(&asm, &params, false, None, 1, None, Finish::WhenDue).unwrap()
+        };
+        let certified = verdicts();
+        assert_eq!(certified.map, StressMap::Certificates);
+        assert!(certified.complete && certified.first_failure.is_none());
+        // The certificates hold the overhang within its clutch, by some
+        // equilibrium of their own.
+        assert!(certified.last.stands() && certified.last.max_usage > 0.0);
+        let later = Instant::now() + Duration::from_secs(60);
+        // The program would take longer than the time left: the map stays
+        // the certificates', and no program is solved.
+        let slow = MapCost {
+            pieces: 3,
+            seconds: 3600.0,
+        };
+        let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
+        let drawn = map_finished(
+            &mut check,
+            &mut finished,
+            &asm,
+            &params,
+            later,
+            &slow,
+            &mut counts,
+        );
+        assert_eq!(drawn.unwrap(), StressMap::Certificates);
+        assert_eq!(
+            (check.last.pieces, counts.solves),
+            (certified.last.pieces, 0)
+        );
+        assert!(finished.is_none());
+        // In time: the program's map, solved once, kept for the next asker.
+        let quick = MapCost {
+            pieces: 3,
+            seconds: 0.01,
+        };
+        let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
+        let drawn = map_finished(
+            &mut check,
+            &mut finished,
+            &asm,
+            &params,
+            later,
+            &quick,
+            &mut counts,
+        );
+        assert_eq!(drawn.unwrap(), StressMap::Program);
+        assert_eq!(counts.solves, 1);
+        assert_eq!(check.last.pieces, whole.pieces);
+        assert_eq!(finished.as_ref().map(|f| &f.pieces), Some(&whole.pieces));
+        // Known already: taken as it is, nothing solved again.
+        let mut again = verdicts();
+        let drawn = map_finished(
+            &mut again,
+            &mut finished,
+            &asm,
+            &params,
+            later,
+            &slow,
+            &mut counts,
+        );
+        assert_eq!((drawn.unwrap(), counts.solves), (StressMap::Program, 1));
+        assert_eq!(again.last.pieces, whole.pieces);
+        assert_eq!(again.steps.last().unwrap().min_score, whole.min_score);
+        // Twice the pieces: the time grows as the programs' does.
+        let t = quick.seconds(6);
+        assert!((t - 0.01 * 2f64.powf(crate::physics::PROGRAM_GROWTH)).abs() < 1e-12);
+        assert!(!slow.fits(3, later) && quick.fits(3, later));
+    }
 
     #[test]
     fn an_analysis_follows_its_pieces_into_another_order() {
