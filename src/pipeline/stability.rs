@@ -635,6 +635,7 @@ fn check_the_rest(
         }
     }
     best.check.last = best.finished(params, counts)?.clone();
+    best.check.map = StressMap::Program;
     best.check.complete = false;
     best.partial = false;
     Ok(())
