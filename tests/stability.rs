@@ -393,3 +393,41 @@ fn the_order_repair_puts_the_counterweight_before_the_overhang() {
     let again = analyze_steps(&fixed.assembly, &params, false).unwrap();
     assert_eq!(again.first_failure, None, "{again:?}");
 }
+
+#[test]
+fn the_order_repair_stops_once_a_deferred_piece_is_shut_in() {
+    // The overhang of `overhang_first` tips its base at step 2 and is
+    // deferred. A pillar of three 1x1 bricks on the table beside it (step
+    // 3) and a 2x4 roof on the pillar, over the overhang's place one layer
+    // clear of it (step 4), shut it in: under the roof and over the base,
+    // its studs cannot slide out. A stack on the base and a 1x6 from it
+    // to the roof join the two parts (step 5). No order that builds the
+    // overhang after the roof passes the verifier, so the repair gives up
+    // there instead of walking on.
+    let piece = |id: &str, x: i32, y: i32, z: i32, step: u32| Placed {
+        placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, y, z), Rot::R0),
+        step: Step(step),
+        color: Color::RED,
+    };
+    let mut pieces = vec![piece("3010", 0, 0, 0, 1), piece("3009", 3, 0, 1, 2)];
+    pieces.extend((0..3).map(|z| piece("3005", 6, 1, z, 3)));
+    pieces.push(piece("3001", 4, 0, 3, 4));
+    pieces.extend((1..4).map(|z| piece("3005", 1, 0, z, 5)));
+    pieces.push(piece("3009", 1, 0, 4, 5));
+    let asm = Assembly {
+        pieces,
+        layer_ldu: 24,
+    };
+    assert!(verify(&asm, None).is_ok(), "{}", verify(&asm, None));
+    let params = Params::default();
+    assert_eq!(
+        analyze_steps(&asm, &params, false).unwrap().first_failure,
+        Some(2)
+    );
+    // The overhang anywhere after the roof: the verifier refuses it.
+    let mut late = asm.clone();
+    let overhang = late.pieces.remove(1);
+    late.pieces.insert(5, overhang);
+    assert!(!verify(&late, None).is_ok());
+    assert!(reorder(&asm, &params, 2, None).unwrap().is_none());
+}

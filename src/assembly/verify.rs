@@ -605,6 +605,30 @@ fn moved(b: &CellBox, min: Cell) -> CellBox {
     CellBox { min, ..*b }
 }
 
+/// The pieces put in place so far, for asking whether another can still
+/// be put in place after them by the placeability rule of the module docs
+/// (as [`verify`] asks it). More pieces never make a piece placeable
+/// again: its free positions only shrink and the space it must reach only
+/// moves away.
+pub(crate) struct Placing(Occupied);
+
+impl Placing {
+    /// Nothing placed yet, of the pieces `all` (those that may be added).
+    pub(crate) fn new<'a>(all: impl IntoIterator<Item = &'a CellBox>) -> Placing {
+        Placing(Occupied::new(all))
+    }
+
+    /// Puts the piece in box `b` in place.
+    pub(crate) fn add(&mut self, b: &CellBox) {
+        self.0.add(b);
+    }
+
+    /// Whether the piece in box `b` can be put in place now.
+    pub(crate) fn placeable(&self, b: &CellBox) -> bool {
+        placeable(b, &self.0)
+    }
+}
+
 /// The placeability rule of the module docs.
 fn placeable(b: &CellBox, occ: &Occupied) -> bool {
     let Some((lo, hi)) = occ.bounds else {

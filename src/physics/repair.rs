@@ -25,6 +25,7 @@ use serde::Serialize;
 use super::certify::{Certifier, Verdict};
 use super::model::Structure;
 use super::{analyze, Analysis, Params, PhysicsError};
+use crate::assembly::verify::Placing;
 use crate::assembly::{Assembly, Placed, Step};
 
 /// A piece the repair moved to a later step.
@@ -66,7 +67,10 @@ pub const MAX_REPAIRED_STEP: usize = 3 * crate::assembly::STEP_PIECES;
 /// that the pieces which break off or fall are added only once the
 /// structure holds them. `None` when nothing could be moved, or when the
 /// structure would hold them only in a step of more than
-/// [`MAX_REPAIRED_STEP`] pieces, or the deadline passed first.
+/// [`MAX_REPAIRED_STEP`] pieces, or a piece of the new order could not be
+/// put in place after the pieces before it, or a deferred piece no longer
+/// could after what is built (the verifier would refuse the order: the
+/// walk stops there), or the deadline passed first.
 pub fn reorder(
     assembly: &Assembly,
     params: &Params,
@@ -80,6 +84,11 @@ pub fn reorder(
         .map(|p| p.placement.body(assembly.layer_ldu))
         .collect();
     let neighbours = crate::assembly::verify::connections(&bodies);
+    // What is placed, for whether each piece of the new order can be put
+    // in place after the pieces before it, and whether a deferred piece
+    // still can be after what is built: once one cannot, the verifier
+    // would refuse the new order, so the walk stops there.
+    let mut placing = Placing::new(bodies.iter().map(|b| &b.bbox));
     // Pieces on the ground may start a part of their own, as the verifier
     // allows.
     let ground = bodies.iter().map(|b| b.bbox.min.z).min().unwrap_or(0);
@@ -112,6 +121,7 @@ pub fn reorder(
                 placed.push(i);
                 is_placed[i] = true;
                 cert.place(i);
+                placing.add(&bodies[i].bbox);
             }
             steps.push(group);
             continue;
@@ -170,9 +180,15 @@ pub fn reorder(
                     return Ok(None);
                 }
                 for &i in &kept {
+                    // Shut out by what is built before it in the new
+                    // order: the verifier would refuse the order.
+                    if !placing.placeable(&bodies[i].bbox) {
+                        return Ok(None);
+                    }
                     placed.push(i);
                     is_placed[i] = true;
                     trial.remove(&i);
+                    placing.add(&bodies[i].bbox);
                 }
                 steps.push(kept);
                 break;
@@ -185,6 +201,11 @@ pub fn reorder(
         trial.extend(held);
         for &i in &trial {
             was_deferred[i] = true;
+        }
+        // A deferred piece shut out by what is built (it comes after all
+        // of it): the verifier would refuse the new order.
+        if trial.iter().any(|&i| !placing.placeable(&bodies[i].bbox)) {
+            return Ok(None);
         }
         deferred = trial;
     }
@@ -206,8 +227,12 @@ pub fn reorder(
                 return Ok(None);
             }
             for &i in &kept {
+                if !placing.placeable(&bodies[i].bbox) {
+                    return Ok(None);
+                }
                 placed.push(i);
                 is_placed[i] = true;
+                placing.add(&bodies[i].bbox);
             }
             rest.retain(|i| !is_placed[*i]);
             steps.push(kept);
