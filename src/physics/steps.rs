@@ -338,15 +338,18 @@ struct Ask<'a> {
     map: bool,
 }
 
-/// When a step check makes the finished model's analysis.
+/// When a step check makes the finished model's analysis
+/// ([`StepsAnalysis::finished`]; see [`analyze_steps_verdicts`]).
 #[derive(Debug, Clone, Copy)]
 pub enum Finish<'a> {
     /// Alongside the steps, from the start.
     Alongside,
     /// Alongside the steps once it is due: when the check would otherwise
-    /// stop to keep time for it ([`Reserve`]), which gives the check the
-    /// cores the analysis leaves idle; else (a check that ends in time)
-    /// after them, of the groups the last step did not solve.
+    /// stop to keep time for it (estimated from the biggest program solved
+    /// so far, as [`analyze_steps_within`] does), which gives the check
+    /// the cores the analysis leaves idle; else (a check that ends in
+    /// time) after them, of the groups the last step did not solve, unless
+    /// the check asks for verdicts only ([`analyze_steps_verdicts`]).
     WhenDue,
     /// Known already.
     Known(&'a Analysis),
