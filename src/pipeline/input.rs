@@ -33,8 +33,8 @@ pub fn load_rules(path: Option<&Path>) -> Result<RuleSet, RuleError> {
     }
 }
 
-/// Loads the rule file and the template, so that a bad one fails before
-/// any slow work.
+/// Loads the rule file and the template (while the mesh loads: a bad one
+/// fails the build before the mesh is voxelized).
 pub(super) fn setup(opts: &BuildOptions) -> Result<Setup, BuildError> {
     let rules = load_rules(opts.rules.as_deref())?.restricted(|p| match p.spec().family() {
         Family::Brick => true,
