@@ -175,6 +175,27 @@ impl Arms {
     fn run(&self, r: &Run) -> &[Arm] {
         &self.arms[r.from as usize..r.to as usize]
     }
+
+    /// Marks in `found` each variant of run `r` not `hit` yet whose other
+    /// piece, at its offset from `at`, lies where `there` says it may (and
+    /// in `hit`, so it is looked at once).
+    fn mark(
+        &self,
+        r: &Run,
+        at: Cell,
+        there: impl Fn(&Arm, Cell) -> bool,
+        hit: &mut [bool],
+        found: &mut [bool],
+    ) {
+        for arm in self.run(r) {
+            let v = arm.variant as usize;
+            let (ox, oy, oz) = arm.offset;
+            if !hit[v] && there(arm, at.offset(ox, oy, oz)) {
+                hit[v] = true;
+                found[v] = true;
+            }
+        }
+    }
 }
 
 /// The least and greatest cell of a set of cells, on each axis.
@@ -897,17 +918,8 @@ impl<'a> Trace<'a> {
                     if w & run.dir == 0 {
                         continue;
                     }
-                    for arm in arms.run(run) {
-                        let v = arm.variant as usize;
-                        if hit[v] {
-                            continue;
-                        }
-                        let (ox, oy, oz) = arm.offset;
-                        if ok_at(arm.other as usize, b.origin.offset(ox, oy, oz)) {
-                            hit[v] = true;
-                            found[v] = true;
-                        }
-                    }
+                    let there = |arm: &Arm, c: Cell| ok_at(arm.other as usize, c);
+                    arms.mark(run, b.origin, there, &mut hit, &mut found);
                 }
             }
         }
@@ -953,14 +965,7 @@ impl<'a> Trace<'a> {
                         if !span.meets(o, run) {
                             continue;
                         }
-                        for arm in arms.run(run) {
-                            let v = arm.variant as usize;
-                            let (ox, oy, oz) = arm.offset;
-                            if !hit[v] && spots.get(o.offset(ox, oy, oz)) {
-                                hit[v] = true;
-                                found[v] = true;
-                            }
-                        }
+                        arms.mark(run, o, |_, c| spots.get(c), &mut hit, &mut found);
                     }
                 }
             }
@@ -978,14 +983,7 @@ impl<'a> Trace<'a> {
                         if !span.meets(a, run) {
                             continue;
                         }
-                        for arm in arms.run(run) {
-                            let v = arm.variant as usize;
-                            let (ox, oy, oz) = arm.offset;
-                            if !hit[v] && way.get(a.offset(ox, oy, oz)) {
-                                hit[v] = true;
-                                found[v] = true;
-                            }
-                        }
+                        arms.mark(run, a, |_, c| way.get(c), &mut hit, &mut found);
                     }
                 }
             }
