@@ -24,7 +24,7 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::{Dir, Rule, RuleSet, StartRule};
+use super::{Dir, Rule, RuleSet, StartRule, Variant, VariantKey};
 use crate::catalog::{Family, PartKind};
 use crate::geom::Rot;
 
@@ -68,9 +68,6 @@ fn joint_factor(a: (i32, i32), b_at: (i32, i32), b: (i32, i32)) -> f64 {
     }
 }
 
-/// A rotated rule's geometry: anchor, its turn, new piece, its turn, offset, side.
-type VariantKey = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
-
 /// Generates the rule set for `alphabet`: every pair, every rotation of the
 /// new piece, every overlapping offset, up and down; one rule per class of
 /// rules that only differ by a turn of the whole.
@@ -98,20 +95,7 @@ pub fn generate(alphabet: &[&str]) -> RuleSet {
                 else {
                     continue;
                 };
-                let keys: Vec<_> = one
-                    .variants()
-                    .iter()
-                    .map(|v| {
-                        (
-                            v.anchor,
-                            v.anchor_rot,
-                            v.added,
-                            v.added_rot,
-                            v.offset,
-                            v.dir,
-                        )
-                    })
-                    .collect();
+                let keys: Vec<VariantKey> = one.variants().iter().map(Variant::key).collect();
                 if keys.iter().any(|k| seen.contains(k)) {
                     continue;
                 }

@@ -162,6 +162,24 @@ pub struct Variant {
     pub weight: f64,
 }
 
+/// A variant's geometry, all that two variants must share to be the same
+/// move: anchor and its turn, new piece and its turn, offset, side.
+pub type VariantKey = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
+
+impl Variant {
+    /// Its geometry ([`VariantKey`]): what the search matches.
+    pub fn key(&self) -> VariantKey {
+        (
+            self.anchor,
+            self.anchor_rot,
+            self.added,
+            self.added_rot,
+            self.offset,
+            self.dir,
+        )
+    }
+}
+
 /// Which rule added a piece.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum RuleRef {
@@ -439,17 +457,8 @@ impl RuleSet {
         let Some(w) = weight else {
             return self;
         };
-        type Key = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
-        let key = |v: &Variant| {
-            (
-                v.anchor,
-                v.anchor_rot,
-                v.added,
-                v.added_rot,
-                v.offset,
-                v.dir,
-            )
-        };
+        let key = Variant::key;
+        type Key = VariantKey;
         let mut seen: crate::keyhash::KeySet<Key> = self.variants.iter().map(key).collect();
         // Every rule between two parts that connects, with its turns, in
         // the order the loops make them: made for each anchor in parallel

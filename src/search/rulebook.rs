@@ -25,14 +25,7 @@ impl RuleBook {
             KeyMap::with_capacity_and_hasher(rules.variants().len(), Default::default());
         let mut sums: KeyMap<PartKind, (f64, usize)> = KeyMap::default();
         for v in rules.variants() {
-            let key = (
-                v.anchor,
-                v.anchor_rot,
-                v.added,
-                v.added_rot,
-                v.offset,
-                v.dir,
-            );
+            let key = v.key();
             for part in [v.anchor, v.added] {
                 let s = sums.entry(part).or_default();
                 s.0 += v.weight;

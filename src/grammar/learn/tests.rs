@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use super::*;
 use crate::geom::Cell;
 use crate::grammar::defaults::generate;
-use crate::grammar::{Variant, DEFAULT_ALPHABET};
+use crate::grammar::{Variant, VariantKey, DEFAULT_ALPHABET};
 use crate::ldraw::{parse_ldr, placement_position, rot_matrix};
 
 fn kind(id: &str) -> PartKind {
@@ -333,20 +333,6 @@ fn one_joint_seen_at_all_four_turns_is_one_rule_counted_four_times() {
     );
 }
 
-/// What the search matches: a variant's geometry.
-type VariantKey = (PartKind, Rot, PartKind, Rot, (i32, i32, i32), Dir);
-
-fn variant_key(v: &Variant) -> VariantKey {
-    (
-        v.anchor,
-        v.anchor_rot,
-        v.added,
-        v.added_rot,
-        v.offset,
-        v.dir,
-    )
-}
-
 /// The variant an observed joint of `b` to `a` is, in a rule set's grid of
 /// `layer_ldu`-high layers.
 fn observed_variant(a: &Placement, b: &Placement, dir: Dir, layer_ldu: i32) -> VariantKey {
@@ -424,7 +410,7 @@ fn the_learned_rule_set_has_exactly_the_variants_of_the_observed_joints() {
     // the observed joints and all their turns, each once.
     let rs = RuleSet::parse(&l.to_rules_text(), Path::new("learned.rules")).unwrap();
     assert_eq!(rs.variants(), l.rule_set().variants());
-    let keys: Vec<VariantKey> = rs.variants().iter().map(variant_key).collect();
+    let keys: Vec<VariantKey> = rs.variants().iter().map(Variant::key).collect();
     let distinct: BTreeSet<VariantKey> = keys.iter().copied().collect();
     assert_eq!(
         distinct.len(),
@@ -437,7 +423,7 @@ fn the_learned_rule_set_has_exactly_the_variants_of_the_observed_joints() {
     // that are turns of each other in its own way.
     let generated = generate(&DEFAULT_ALPHABET);
     assert_eq!(rs.rules().len(), generated.rules().len());
-    let generated: BTreeSet<VariantKey> = generated.variants().iter().map(variant_key).collect();
+    let generated: BTreeSet<VariantKey> = generated.variants().iter().map(Variant::key).collect();
     assert_eq!(distinct, generated);
 
     // Each rule's count is shared among its turns.
