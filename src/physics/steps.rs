@@ -271,21 +271,9 @@ pub fn analyze_steps_with_finished(
     tell: Option<&dyn Fn(u64, u64)>,
     known: Option<&Analysis>,
 ) -> Result<StepsAnalysis, PhysicsError> {
-    if known.is_some_and(|a| a.pieces.len() != assembly.pieces.len()) {
-        return Err(PhysicsError::Bug(
-            "the finished model's analysis given is of another assembly".into(),
-        ));
-    }
-    let ask = Ask {
-        assembly,
-        params,
-        stop_at_first_failure,
-        deadline,
-        from,
-        tell,
-        map: true,
-    };
-    check_steps(&ask, known.map_or(Finish::Alongside, Finish::Known))
+    let finish = known.map_or(Finish::Alongside, Finish::Known);
+    let ask = (stop_at_first_failure, deadline, from, tell);
+    check_asked(assembly, params, ask, finish, true)
 }
 
 /// The verdict of every step, as [`analyze_steps_told`] gives it, for a
@@ -306,6 +294,25 @@ pub fn analyze_steps_verdicts(
     tell: Option<&dyn Fn(u64, u64)>,
     finish: Finish,
 ) -> Result<StepsAnalysis, PhysicsError> {
+    let ask = (stop_at_first_failure, deadline, from, tell);
+    check_asked(assembly, params, ask, finish, false)
+}
+
+/// What the step checks' public functions are asked besides the build:
+/// stop at the first failure, the deadline, the first step, the progress
+/// callback.
+type Asked<'a> = (bool, Option<Instant>, u32, Option<&'a dyn Fn(u64, u64)>);
+
+/// The check of [`analyze_steps_with_finished`] and
+/// [`analyze_steps_verdicts`]; `map` whether the finished model's map
+/// comes from its program.
+fn check_asked(
+    assembly: &Assembly,
+    params: &Params,
+    (stop_at_first_failure, deadline, from, tell): Asked<'_>,
+    finish: Finish,
+    map: bool,
+) -> Result<StepsAnalysis, PhysicsError> {
     if let Finish::Known(a) = finish {
         if a.pieces.len() != assembly.pieces.len() {
             return Err(PhysicsError::Bug(
@@ -320,7 +327,7 @@ pub fn analyze_steps_verdicts(
         deadline,
         from,
         tell,
-        map: false,
+        map,
     };
     check_steps(&ask, finish)
 }
