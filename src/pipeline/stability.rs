@@ -1141,6 +1141,12 @@ mod tests {
         // equilibrium of their own.
         assert!(certified.last.stands() && certified.last.max_usage > 0.0);
         let later = Instant::now() + Duration::from_secs(60);
+        let draw = |check: &mut StepsAnalysis,
+                    finished: &mut Option<Analysis>,
+                    cost: &MapCost,
+                    counts: &mut Counts| {
+            map_finished(check, finished, &asm, &params, later, cost, counts)
+        };
         // The program would take longer than the time left: the map stays
         // the certificates', and no program is solved.
         let slow = MapCost {
@@ -1148,15 +1154,7 @@ mod tests {
             seconds: 3600.0,
         };
         let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
-        let drawn = map_finished(
-            &mut check,
-            &mut finished,
-            &asm,
-            &params,
-            later,
-            &slow,
-            &mut counts,
-        );
+        let drawn = draw(&mut check, &mut finished, &slow, &mut counts);
         assert_eq!(drawn.unwrap(), StressMap::Certificates);
         assert_eq!(
             (check.last.pieces, counts.solves),
@@ -1169,30 +1167,14 @@ mod tests {
             seconds: 0.01,
         };
         let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
-        let drawn = map_finished(
-            &mut check,
-            &mut finished,
-            &asm,
-            &params,
-            later,
-            &quick,
-            &mut counts,
-        );
+        let drawn = draw(&mut check, &mut finished, &quick, &mut counts);
         assert_eq!(drawn.unwrap(), StressMap::Program);
         assert_eq!(counts.solves, 1);
         assert_eq!(check.last.pieces, whole.pieces);
         assert_eq!(finished.as_ref().map(|f| &f.pieces), Some(&whole.pieces));
         // Known already: taken as it is, nothing solved again.
         let mut again = verdicts();
-        let drawn = map_finished(
-            &mut again,
-            &mut finished,
-            &asm,
-            &params,
-            later,
-            &slow,
-            &mut counts,
-        );
+        let drawn = draw(&mut again, &mut finished, &slow, &mut counts);
         assert_eq!((drawn.unwrap(), counts.solves), (StressMap::Program, 1));
         assert_eq!(again.last.pieces, whole.pieces);
         assert_eq!(again.steps.last().unwrap().min_score, whole.min_score);
