@@ -198,6 +198,22 @@ impl Arms {
     }
 }
 
+/// Adds cell `o` to a set of cells kept as a grid of `dims` and its span,
+/// made at its first cell.
+fn add_cell(set: &mut Option<(VoxelGrid, Span)>, o: Cell, (nx, ny, nz): (i32, i32, i32)) {
+    match set {
+        Some((g, span)) => {
+            g.set(o, true);
+            span.grow(o);
+        }
+        none => {
+            let mut g = VoxelGrid::new(nx, ny, nz);
+            g.set(o, true);
+            *none = Some((g, Span::of(o)));
+        }
+    }
+}
+
 /// The least and greatest cell of a set of cells, on each axis.
 #[derive(Debug, Clone, Copy)]
 struct Span {
@@ -878,17 +894,7 @@ impl<'a> Trace<'a> {
                 for (k, (dir, up)) in [(UP, true), (DOWN, false)].into_iter().enumerate() {
                     if self.can_place(&b, &[], up) {
                         w |= dir;
-                        match &mut ways[s][k] {
-                            Some((g, span)) => {
-                                g.set(o, true);
-                                span.grow(o);
-                            }
-                            none => {
-                                let mut g = VoxelGrid::new(nx, ny, nz);
-                                g.set(o, true);
-                                *none = Some((g, Span::of(o)));
-                            }
-                        }
+                        add_cell(&mut ways[s][k], o, (nx, ny, nz));
                     }
                 }
                 if w != 0 {
@@ -932,17 +938,7 @@ impl<'a> Trace<'a> {
             for a in self.spots_at(node, ix.shapes[*shape]).iter() {
                 if !self.stay.contains(a) && self.left.in_bounds(a.origin) {
                     let o = a.origin;
-                    match &mut free_spots[*shape] {
-                        Some((g, span)) => {
-                            g.set(o, true);
-                            span.grow(o);
-                        }
-                        none => {
-                            let mut g = VoxelGrid::new(nx, ny, nz);
-                            g.set(o, true);
-                            *none = Some((g, Span::of(o)));
-                        }
-                    }
+                    add_cell(&mut free_spots[*shape], o, (nx, ny, nz));
                     from_anchors += arms.len();
                 }
             }
