@@ -212,9 +212,9 @@ impl Samples {
                 if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 {
                     continue;
                 }
-                let first = (lo.max(0.0) as usize / rows).min(bands);
+                let first = lo.max(0.0) as usize / rows;
                 let last = (hi as usize / rows).min(bands - 1);
-                for band in &mut binned[first..=last.max(first).min(bands - 1)] {
+                for band in binned.iter_mut().take(last + 1).skip(first) {
                     band.push(k as u32);
                 }
             }
