@@ -150,6 +150,7 @@ mod certify;
 mod compression;
 mod groups;
 mod model;
+mod pending;
 pub mod repair;
 mod steps;
 pub mod support;
@@ -161,6 +162,7 @@ use crate::catalog::PartSpec;
 
 use crate::assembly::Assembly;
 
+pub use pending::Pending;
 pub use steps::{
     analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_verdicts,
     analyze_steps_with_finished, analyze_steps_within, Finish, PROGRAM_GROWTH,
@@ -447,7 +449,7 @@ impl StepsAnalysis {
 }
 
 /// Why an analysis failed.
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum PhysicsError {
     /// The solver gave up on a group of pieces.
     #[error(

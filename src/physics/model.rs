@@ -138,6 +138,9 @@ pub(super) struct Structure {
     pub contacts: Vec<Contact>,
     /// Per piece, the contacts (indices) with a face under it.
     pub under: Vec<Vec<usize>>,
+    /// Once set, the solver stops at its next iteration (the answer is
+    /// no longer wanted: see [`Pending`](super::Pending)).
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Structure {
@@ -168,6 +171,7 @@ impl Structure {
             loads,
             contacts,
             under,
+            stop: None,
         }
     }
 
@@ -553,6 +557,9 @@ pub(super) fn solve_by(
         .map_err(|e| PhysicsError::Bug(format!("solver settings: {e}")))?;
     let mut solver = DefaultSolver::new(&pm, &lp.cost, &a, &b, &cones, settings)
         .map_err(|e| PhysicsError::Bug(format!("solver setup: {e:?}")))?;
+    if let Some(stop) = s.stop.clone() {
+        solver.set_termination_callback(move |_| stop.load(std::sync::atomic::Ordering::Relaxed));
+    }
     solver.solve();
     let status = solver.solution.status;
     if !matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved) {

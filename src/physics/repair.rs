@@ -77,6 +77,18 @@ pub fn reorder(
     first_failure: u32,
     deadline: Option<std::time::Instant>,
 ) -> Result<Option<Reordered>, PhysicsError> {
+    let go = || deadline.is_none_or(|d| std::time::Instant::now() < d);
+    reorder_while(assembly, params, first_failure, &go)
+}
+
+/// [`reorder`], going on while `go` says so (checked before each trial):
+/// `None` once it does not.
+pub fn reorder_while(
+    assembly: &Assembly,
+    params: &Params,
+    first_failure: u32,
+    go: &dyn Fn() -> bool,
+) -> Result<Option<Reordered>, PhysicsError> {
     let n = assembly.pieces.len();
     let bodies: Vec<_> = assembly
         .pieces
@@ -141,7 +153,7 @@ pub fn reorder(
             }
             // The step's own pieces first, then those it now holds.
             kept.sort_by_key(|&i| (was_deferred[i], i));
-            if trials >= budget || deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            if trials >= budget || !go() {
                 return Ok(None);
             }
             trials += 1;

@@ -15,7 +15,8 @@ use super::compression;
 use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
 use super::model::{solve, Contact, Structure};
 use super::{
-    weakest, Analysis, Params, PhysicsError, PieceStress, StepCheck, StepsAnalysis, StressMap,
+    weakest, Analysis, Params, Pending, PhysicsError, PieceStress, StepCheck, StepsAnalysis,
+    StressMap,
 };
 
 /// How a job's answer was found.
@@ -360,6 +361,10 @@ pub enum Finish<'a> {
     WhenDue,
     /// Known already.
     Known(&'a Analysis),
+    /// Being made on a thread of its own, since before the check: the
+    /// last step waits for it; a check that stops before the last step
+    /// leaves it running (and [`StepsAnalysis::finished`] empty).
+    Pending(&'a Pending),
 }
 
 /// The finished model's groups, solved: each piece's stress and the
@@ -367,7 +372,7 @@ pub enum Finish<'a> {
 type Finished = (Vec<PieceStress>, f64);
 
 /// Where the finished model's analysis is.
-enum State {
+enum State<'p> {
     /// Not started: it starts once due.
     Due,
     /// Running since `since`, its answer to come on `answer`; `due`: it
@@ -379,6 +384,8 @@ enum State {
     },
     /// Made, or given.
     Done(Finished),
+    /// Being made outside the check ([`Finish::Pending`]).
+    Pending(&'p Pending),
 }
 
 /// The finished model's analysis as the step check goes: its programs
@@ -391,7 +398,7 @@ struct Finisher<'a, 'scope> {
     params: &'scope Params,
     /// Pieces of the finished model.
     n: usize,
-    state: State,
+    state: State<'a>,
     /// Whether its programs were solved here.
     made: bool,
     /// Whether programs spawned now run beside the check: it is not on a
@@ -407,11 +414,12 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
         s: &'scope Structure,
         params: &'scope Params,
         n: usize,
-        finish: Finish,
+        finish: Finish<'a>,
     ) -> Self {
         let state = match finish {
             Finish::Known(a) => State::Done((a.pieces.clone(), a.solve_seconds)),
             Finish::Alongside | Finish::WhenDue => State::Due,
+            Finish::Pending(p) => State::Pending(p),
         };
         let mut f = Finisher {
             scope,
@@ -480,12 +488,27 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
             State::Running {
                 since, due: false, ..
             } => reserve.cut(deadline, *since, Finishing::Alongside),
+            State::Pending(p) => reserve.cut(deadline, p.since(), Finishing::Alongside),
             State::Running { due: true, .. } | State::Done(_) => deadline,
         })
     }
 
+    /// Waits for the analysis if it runs here: its answer, once made. One
+    /// made outside the check ([`State::Pending`]) is not waited for: the
+    /// check stopped before its last step, which did not need it.
+    fn answer(&mut self) -> Result<Option<&Finished>, PhysicsError> {
+        if matches!(self.state, State::Pending(_)) {
+            return Ok(None);
+        }
+        self.wait()
+    }
+
     /// Waits for the analysis if it runs: its answer, once made.
     fn wait(&mut self) -> Result<Option<&Finished>, PhysicsError> {
+        if let State::Pending(p) = self.state {
+            let a = p.wait()?;
+            self.state = State::Done((a.pieces, a.solve_seconds));
+        }
         if let State::Running { answer, .. } = &self.state {
             let r = loop {
                 match answer.try_recv() {
@@ -678,6 +701,22 @@ fn check_steps_in(
                     step_seconds = *secs;
                 }
                 for job in late.drain(..) {
+                    // The program's least usage may overload a joint of a
+                    // group another equilibrium holds within every
+                    // capacity: its answer certifies only a group it
+                    // holds, and the others are certified as any step's.
+                    if job.grounded && job.pieces.iter().any(|&p| whole[p].fails()) {
+                        let new: Vec<usize> =
+                            job.pieces.iter().copied().filter(|&p| p >= begin).collect();
+                        if let Verdict::Stands(stress) = cert.certify(job, &new) {
+                            for (&p, st) in job.pieces.iter().zip(stress) {
+                                current[p] = st;
+                                exact[p] = false;
+                            }
+                            certified += 1;
+                            continue;
+                        }
+                    }
                     for &p in &job.pieces {
                         current[p] = whole[p];
                         exact[p] = true;
@@ -717,7 +756,13 @@ fn check_steps_in(
     // The finished build (or the failing step) afresh; past the deadline,
     // the finished build.
     let end = if complete { begin } else { n };
-    let finished = fin.wait()?.cloned();
+    // One being made outside the check is waited for only when the check
+    // needs the finished model: at its last step, or when cut short.
+    let finished = if complete {
+        fin.answer()?.cloned()
+    } else {
+        fin.wait()?.cloned()
+    };
     solves += usize::from(fin.made);
     // A complete check has found the last step's groups already, most of
     // them exactly: only the others are solved again.

@@ -26,11 +26,11 @@ use serde::Serialize;
 use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, Placement};
 use crate::catalog::Color;
-use crate::physics::repair::{reorder, Moved, MAX_REPAIRED_STEP};
+use crate::physics::repair::{reorder_while, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
-    analyze, analyze_steps_verdicts, Analysis, Finish, Ground, Params, PhysicsError, StepsAnalysis,
-    StressMap,
+    analyze, analyze_steps_verdicts, Analysis, Finish, Ground, Params, Pending, PhysicsError,
+    StepsAnalysis, StressMap,
 };
 use crate::search::SearchOutcome;
 
@@ -206,13 +206,23 @@ pub fn settle(
         tell,
         None,
     )?;
-    let cost = MapCost::of(&first);
-    let before = Before {
+    let mut before = Before {
         first_failure: first.check.first_failure,
-        min_score: first.finished.as_ref().map_or(0.0, |f| f.min_score),
-        final_stands: first.finished.as_ref().is_some_and(Analysis::stands),
+        min_score: 0.0,
+        final_stands: false,
     };
     let mut best = first;
+    // How the finished model stood before repairs, for the report: its
+    // analysis may still be being made (on a core of its own, while the
+    // repairs go on), and a repair drops the attempt it was made for.
+    let mut unrepaired = if before.first_failure.is_some() {
+        best.finished
+            .clone()
+            .map(Ok)
+            .or_else(|| best.pending.clone().map(Err))
+    } else {
+        None
+    };
     let mut reseeded = None;
     let mut repairs = Vec::new();
     // Support columns first: they keep the model's own layout.
@@ -289,8 +299,25 @@ pub fn settle(
             ));
         }
     }
+    if let Some(first) = unrepaired.take() {
+        let f = match first {
+            Ok(known) => known,
+            Err(pending) => {
+                counts.solves += 1;
+                pending.wait()?
+            }
+        };
+        before.min_score = f.min_score;
+        before.final_stands = f.stands();
+    }
+    // The order repair was tried on the first layout while its finished
+    // model's analysis was being made: only one that stands has an order
+    // to repair (another layout's was known before its repair).
+    let order_tried = best
+        .order_tried
+        .filter(|_| reseeded.is_some() || before.final_stands);
     if mode == Stability::Repair && before.first_failure.is_some() {
-        match (&best.order_fix, best.order_tried) {
+        match (&best.order_fix, order_tried) {
             (Some(moved), _) => repairs.push(format!(
                 "order: {} pieces moved to later steps, where the structure holds them",
                 moved.len()
@@ -321,16 +348,15 @@ pub fn settle(
         }
     }
     // A check that stopped at its first failure: the rest of it.
-    check_the_rest(&mut best, params, deadline, &cost, &mut counts)?;
+    check_the_rest(&mut best, params, deadline, &mut counts)?;
     // The finished model's map, once: its program's, unless that would not
     // end by the deadline.
     let stress_map = map_finished(
         &mut best.check,
-        &mut best.finished,
+        (&mut best.finished, &mut best.pending),
         &best.plan.1,
         params,
         deadline,
-        &cost,
         &mut counts,
     )?;
     let mut on_baseplate = None;
@@ -408,6 +434,9 @@ struct Attempt {
     partial: bool,
     /// The finished model's analysis, once made.
     finished: Option<Analysis>,
+    /// The finished model's analysis, while it is being made (on a
+    /// thread of its own, see [`Pending`]); `None` once `finished` is.
+    pending: Option<Pending>,
     /// The pieces the order repair moved, when it was kept.
     order_fix: Option<Vec<Moved>>,
     /// The step the order repair tried and could not fix.
@@ -417,11 +446,39 @@ struct Attempt {
 }
 
 impl Attempt {
-    /// How long the finished model's analysis took (zero when not made).
+    /// How long the finished model's analysis took (zero when not made;
+    /// while it is being made, how long it has taken so far).
     fn analysis_time(&self) -> Duration {
         // Capped at about 31 years, so that adding it to a time is safe.
-        let secs = self.finished.as_ref().map_or(0.0, |f| f.solve_seconds);
+        let secs = match (&self.finished, &self.pending) {
+            (Some(f), _) => f.solve_seconds,
+            (None, Some(p)) => p.since().elapsed().as_secs_f64(),
+            (None, None) => 0.0,
+        };
         Duration::from_secs_f64(secs.clamp(0.0, 1e9))
+    }
+
+    /// The finished model's analysis for a step check: known, or being
+    /// made.
+    fn finish(&self) -> Finish<'_> {
+        match (&self.finished, &self.pending) {
+            (Some(f), _) => Finish::Known(f),
+            (None, Some(p)) => Finish::Pending(p),
+            (None, None) => Finish::WhenDue,
+        }
+    }
+
+    /// Takes the finished model's analysis from its check, when that
+    /// made it or waited for it.
+    fn take_finished(&mut self, counts: &mut Counts) {
+        if let Some(f) = self.check.finished.take() {
+            if self.finished.is_none() {
+                self.finished = Some(f);
+                if self.pending.take().is_some() {
+                    counts.solves += 1;
+                }
+            }
+        }
     }
 
     /// Stands at more steps: the finished model first, then more of the
@@ -451,7 +508,10 @@ impl Attempt {
     ) -> Result<&Analysis, crate::pipeline::BuildError> {
         if self.finished.is_none() {
             counts.solves += 1;
-            self.finished = Some(analyze(&self.plan.1, params)?);
+            self.finished = Some(match self.pending.take() {
+                Some(p) => p.wait()?,
+                None => analyze(&self.plan.1, params)?,
+            });
         }
         Ok(self.finished.as_ref().expect("just made"))
     }
@@ -491,41 +551,63 @@ fn attempt(
     tell: Option<&dyn Fn(u64, u64)>,
     finished: Option<Analysis>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
-    let mut plan = plan;
-    // The finished model is analysed alongside the steps, unless known.
-    let mut check = analyze_steps_verdicts(
-        &plan.1,
-        params,
-        repair,
-        Some(deadline),
-        1,
-        tell,
-        finished.as_ref().map_or(Finish::Alongside, Finish::Known),
-    )?;
-    counts.add(&check);
-    let mut partial = stopped_early(&plan.1, &check);
-    let mut finished = match (finished, check.finished.take()) {
-        (Some(known), _) | (None, Some(known)) => known,
-        (None, None) => {
-            counts.solves += 1;
-            analyze(&plan.1, params)?
-        }
+    // The finished model is analysed on a core of its own from the start,
+    // unless known: the check waits for it at its last step only, and a
+    // check that stops at an earlier failure goes on to the repairs
+    // while it is made.
+    let pending = finished.is_none().then(|| Pending::start(&plan.1, params));
+    let mut at = Attempt {
+        check: analyze_steps_verdicts(
+            &plan.1,
+            params,
+            repair,
+            Some(deadline),
+            1,
+            tell,
+            match (&finished, &pending) {
+                (Some(f), _) => Finish::Known(f),
+                (None, Some(p)) => Finish::Pending(p),
+                (None, None) => Finish::WhenDue,
+            },
+        )?,
+        plan,
+        partial: false,
+        finished,
+        pending,
+        order_fix: None,
+        order_tried: None,
+        supports: Vec::new(),
     };
-    let stands = finished.stands();
-    let mut order_fix = None;
-    let mut order_tried = None;
+    counts.add(&at.check);
+    at.take_finished(counts);
+    at.partial = stopped_early(&at.plan.1, &at.check);
     let in_time = Instant::now() < deadline;
-    if let (true, true, true, Some(step)) = (repair, in_time, stands, check.first_failure) {
-        order_tried = Some(step);
+    // The order repair, unless the finished model is known to fail (no
+    // order makes every step stand then); while its analysis is still
+    // being made, the repair is tried, and kept only if it stands.
+    let known_to_fail = at.finished.as_ref().is_some_and(|f| !f.stands());
+    if let (true, true, false, Some(step)) =
+        (repair, in_time, known_to_fail, at.check.first_failure)
+    {
+        at.order_tried = Some(step);
         // The order repair walks the later steps with an analysis each:
         // on a big build it may not finish, and must leave time for the
         // support columns.
+        // While the finished model's analysis is being made, the repair
+        // goes on beside it, and gives up once it says the model fails.
         let now = Instant::now();
         let share = now + deadline.saturating_duration_since(now) / ORDER_SHARE;
-        if let Some(r) = reorder(&plan.1, params, step, Some(share))? {
+        let pending = at.pending.clone();
+        let go = || {
+            Instant::now() < share
+                && pending
+                    .as_ref()
+                    .is_none_or(|p| p.stands().is_none_or(|stands| stands))
+        };
+        if let Some(r) = reorder_while(&at.plan.1, params, step, &go)? {
             counts.solves += r.solves;
             counts.certified += r.certified;
-            if verify(&r.assembly, Some(&plan.0.voxels)).is_ok() {
+            if verify(&r.assembly, Some(&at.plan.0.voxels)).is_ok() {
                 let c = analyze_steps_verdicts(
                     &r.assembly,
                     params,
@@ -536,28 +618,38 @@ fn attempt(
                     Finish::WhenDue,
                 )?;
                 counts.add(&c);
-                if c.complete && later(c.first_failure, check.first_failure) {
-                    order_fix = Some(r.moved);
-                    // The same pieces in another order: the finished
-                    // model's analysis follows it.
-                    finished = reindexed(&finished, &plan.1, &r.assembly)
-                        .ok_or_else(|| PhysicsError::Bug("the order repair lost a piece".into()))?;
-                    plan.1 = r.assembly;
-                    partial = stopped_early(&plan.1, &c);
-                    check = c;
+                if c.complete && later(c.first_failure, at.check.first_failure) {
+                    if at.finished(params, counts)?.stands() {
+                        order_kept(&mut at, r, c)?;
+                    } else {
+                        at.order_tried = None;
+                    }
                 }
             }
         }
     }
-    Ok(Attempt {
-        plan,
-        check,
-        partial,
-        finished: Some(finished),
-        order_fix,
-        order_tried,
-        supports: Vec::new(),
-    })
+    Ok(at)
+}
+
+/// Keeps the order repair `r` in `at`, whose check of it is `c`.
+fn order_kept(
+    at: &mut Attempt,
+    r: crate::physics::repair::Reordered,
+    c: StepsAnalysis,
+) -> Result<(), crate::pipeline::BuildError> {
+    // The same pieces in another order: the finished model's analysis
+    // follows it.
+    let finished = at
+        .finished
+        .as_ref()
+        .and_then(|f| reindexed(f, &at.plan.1, &r.assembly))
+        .ok_or_else(|| PhysicsError::Bug("the order repair lost a piece".into()))?;
+    at.finished = Some(finished);
+    at.order_fix = Some(r.moved);
+    at.plan.1 = r.assembly;
+    at.partial = stopped_early(&at.plan.1, &c);
+    at.check = c;
+    Ok(())
 }
 
 /// `a`, an analysis of the pieces of `before`, in the order of `after`
@@ -592,12 +684,11 @@ fn stopped_early(asm: &Assembly, check: &StepsAnalysis) -> bool {
 
 /// Completes a check that stopped at its first failure: the steps after
 /// it, and the finished model as its `last`; past the deadline, only the
-/// finished model's analysis (known already) takes `last`'s place.
+/// finished model's analysis takes `last`'s place.
 fn check_the_rest(
     best: &mut Attempt,
     params: &Params,
     deadline: Instant,
-    cost: &MapCost,
     counts: &mut Counts,
 ) -> Result<(), crate::pipeline::BuildError> {
     if !best.partial {
@@ -607,14 +698,12 @@ fn check_the_rest(
         return Ok(());
     };
     if Instant::now() < deadline {
-        // The finished model's analysis, known, or made alongside when it
-        // ends by the deadline (else its map is the certificates'): a
-        // check cut short by the deadline does not make it again.
-        let finish = match &best.finished {
-            Some(known) => Finish::Known(known),
-            None if cost.fits(best.plan.1.pieces.len(), deadline) => Finish::Alongside,
-            None => Finish::WhenDue,
-        };
+        // The finished model's analysis: known, or being made on a core
+        // of its own (started now if it is not): a check cut short by the
+        // deadline does not make it again.
+        if best.finished.is_none() && best.pending.is_none() {
+            best.pending = Some(Pending::start(&best.plan.1, params));
+        }
         let mut c = analyze_steps_verdicts(
             &best.plan.1,
             params,
@@ -622,11 +711,16 @@ fn check_the_rest(
             Some(deadline),
             from,
             None,
-            finish,
+            best.finish(),
         )?;
         counts.add(&c);
-        if best.finished.is_none() {
-            best.finished = c.finished.take();
+        if let Some(f) = c.finished.take() {
+            if best.finished.is_none() {
+                best.finished = Some(f);
+                if best.pending.take().is_some() {
+                    counts.solves += 1;
+                }
+            }
         }
         if c.first_failure.is_some() {
             best.check = spliced(&best.check, from, c);
@@ -641,53 +735,17 @@ fn check_the_rest(
     Ok(())
 }
 
-/// What the finished model's force program is expected to take, from the
-/// first one solved (the plan's, alongside its check).
-struct MapCost {
-    pieces: usize,
-    seconds: f64,
-}
-
-impl MapCost {
-    fn of(first: &Attempt) -> MapCost {
-        MapCost {
-            pieces: first.plan.1.pieces.len(),
-            seconds: first.finished.as_ref().map_or(0.0, |f| f.solve_seconds),
-        }
-    }
-
-    /// The seconds for a model of `pieces` (growing as the programs do,
-    /// see [`crate::physics::PROGRAM_GROWTH`]).
-    fn seconds(&self, pieces: usize) -> f64 {
-        if self.pieces == 0 {
-            return 0.0;
-        }
-        let ratio = pieces as f64 / self.pieces as f64;
-        self.seconds * ratio.powf(crate::physics::PROGRAM_GROWTH)
-    }
-
-    /// Whether the program of a model of `pieces` ends by `deadline`.
-    fn fits(&self, pieces: usize, deadline: Instant) -> bool {
-        let secs = self.seconds(pieces);
-        secs.is_finite()
-            && Duration::try_from_secs_f64(secs)
-                .ok()
-                .and_then(|d| Instant::now().checked_add(d))
-                .is_some_and(|end| end < deadline)
-    }
-}
-
 /// Gives `check`, complete, of `assembly`, the finished model's map from
-/// the force program, once: `finished` when made already, else made now
-/// (and kept there) when it ends by `deadline` (see [`MapCost`]); else
-/// the map stays the certificates'. Returns where the map comes from.
+/// the force program, once: `finished` when made already, else the one
+/// `pending` (started now if none is), if it ends by `deadline` (then
+/// kept in `finished`); else the map stays the certificates'. Returns
+/// where the map comes from.
 fn map_finished(
     check: &mut StepsAnalysis,
-    finished: &mut Option<Analysis>,
+    (finished, pending): (&mut Option<Analysis>, &mut Option<Pending>),
     assembly: &Assembly,
     params: &Params,
     deadline: Instant,
-    cost: &MapCost,
     counts: &mut Counts,
 ) -> Result<StressMap, crate::pipeline::BuildError> {
     let n = assembly.pieces.len();
@@ -696,11 +754,21 @@ fn map_finished(
     }
     let made = match finished {
         Some(f) => f,
-        None if cost.fits(n, deadline) => {
-            counts.solves += 1;
-            finished.insert(analyze(assembly, params)?)
+        // Past the deadline, none is started.
+        None if pending.is_none() && Instant::now() >= deadline => {
+            return Ok(StressMap::Certificates);
         }
-        None => return Ok(StressMap::Certificates),
+        None => {
+            let job = pending
+                .take()
+                .unwrap_or_else(|| Pending::start(assembly, params));
+            // Not made by the deadline: dropped, it stops.
+            let Some(made) = job.wait_until(Some(deadline)) else {
+                return Ok(StressMap::Certificates);
+            };
+            counts.solves += 1;
+            finished.insert(made?)
+        }
     };
     if !check.take_map(made) {
         return Err(
@@ -786,8 +854,13 @@ fn support(
         if !verify(&shored.assembly, Some(&cover)).is_ok() {
             break;
         }
-        // Steps before the first column stand as they did.
+        // Steps before the first column stand as they did. The finished
+        // model with the columns is analysed on a core of its own from
+        // now, for its map if the round is the last (the model without
+        // them needs no more of its own).
         let from = first_change(asm, &shored.assembly);
+        best.pending = None;
+        let job = Pending::start(&shored.assembly, params);
         let mut c = analyze_steps_verdicts(
             &shored.assembly,
             params,
@@ -795,7 +868,7 @@ fn support(
             Some(deadline),
             from,
             None,
-            Finish::WhenDue,
+            Finish::Pending(&job),
         )?;
         counts.add(&c);
         // Out of time part way: the columns are still kept if the steps
@@ -818,14 +891,14 @@ fn support(
         // the steps.
         let whole = c.last.pieces.len() == shored.assembly.pieces.len();
         let program = whole && c.map == StressMap::Program;
-        let finished = c
-            .finished
-            .take()
-            .or_else(|| program.then(|| c.last.clone()));
+        let made = c.finished.take();
+        counts.solves += usize::from(made.is_some());
+        let finished = made.or_else(|| program.then(|| c.last.clone()));
         let candidate = Attempt {
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: spliced(&best.check, from, c),
             partial,
+            pending: finished.is_none().then_some(job),
             finished,
             order_fix,
             order_tried: best.order_tried,
@@ -1143,45 +1216,51 @@ mod tests {
         let later = Instant::now() + Duration::from_secs(60);
         let draw = |check: &mut StepsAnalysis,
                     finished: &mut Option<Analysis>,
-                    cost: &MapCost,
+                    pending: &mut Option<Pending>,
+                    deadline: Instant,
                     counts: &mut Counts| {
-            map_finished(check, finished, &asm, &params, later, cost, counts)
+            map_finished(check, (finished, pending), &asm, &params, deadline, counts)
         };
-        // The program would take longer than the time left: the map stays
+        // Past the deadline, with no program being made: the map stays
         // the certificates', and no program is solved.
-        let slow = MapCost {
-            pieces: 3,
-            seconds: 3600.0,
-        };
         let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
-        let drawn = draw(&mut check, &mut finished, &slow, &mut counts);
+        let drawn = draw(
+            &mut check,
+            &mut finished,
+            &mut None,
+            Instant::now(),
+            &mut counts,
+        );
         assert_eq!(drawn.unwrap(), StressMap::Certificates);
         assert_eq!(
             (check.last.pieces, counts.solves),
             (certified.last.pieces, 0)
         );
         assert!(finished.is_none());
-        // In time: the program's map, solved once, kept for the next asker.
-        let quick = MapCost {
-            pieces: 3,
-            seconds: 0.01,
-        };
-        let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
-        let drawn = draw(&mut check, &mut finished, &quick, &mut counts);
-        assert_eq!(drawn.unwrap(), StressMap::Program);
-        assert_eq!(counts.solves, 1);
-        assert_eq!(check.last.pieces, whole.pieces);
-        assert_eq!(finished.as_ref().map(|f| &f.pieces), Some(&whole.pieces));
-        // Known already: taken as it is, nothing solved again.
-        let mut again = verdicts();
-        let drawn = draw(&mut again, &mut finished, &slow, &mut counts);
-        assert_eq!((drawn.unwrap(), counts.solves), (StressMap::Program, 1));
-        assert_eq!(again.last.pieces, whole.pieces);
-        assert_eq!(again.steps.last().unwrap().min_score, whole.min_score);
-        // Twice the pieces: the time grows as the programs' does.
-        let t = quick.seconds(6);
-        assert!((t - 0.01 * 2f64.powf(crate::physics::PROGRAM_GROWTH)).abs() < 1e-12);
-        assert!(!slow.fits(3, later) && quick.fits(3, later));
+        // In time: the program's map, solved once (on a thread of its own,
+        // started here or before), kept for the next asker.
+        for mut pending in [None, Some(Pending::start(&asm, &params))] {
+            let (mut check, mut finished, mut counts) = (verdicts(), None, Counts::default());
+            let drawn = draw(&mut check, &mut finished, &mut pending, later, &mut counts);
+            assert_eq!(drawn.unwrap(), StressMap::Program);
+            assert_eq!(counts.solves, 1);
+            assert_eq!(check.last.pieces, whole.pieces);
+            assert_eq!(finished.as_ref().map(|f| &f.pieces), Some(&whole.pieces));
+            assert!(pending.is_none());
+            // Known already: taken as it is, nothing solved again, even
+            // past the deadline.
+            let mut again = verdicts();
+            let drawn = draw(
+                &mut again,
+                &mut finished,
+                &mut None,
+                Instant::now(),
+                &mut counts,
+            );
+            assert_eq!((drawn.unwrap(), counts.solves), (StressMap::Program, 1));
+            assert_eq!(again.last.pieces, whole.pieces);
+            assert_eq!(again.steps.last().unwrap().min_score, whole.min_score);
+        }
     }
 
     #[test]

@@ -1,0 +1,144 @@
+//! The finished model's analysis on a thread of its own: started as soon
+//! as the model is known, waited for only where its answer is needed, and
+//! stopped when the model it was made for is given up (a repair changed
+//! it). The step check waits for it at its last step, as for an analysis
+//! made alongside ([`Finish::Pending`](super::Finish::Pending)); a check
+//! that stops at an earlier failure leaves it running.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Instant;
+
+use crate::assembly::Assembly;
+
+use super::{model::Structure, steps, Analysis, Params, PhysicsError};
+
+/// The answer's slot, and the signal that it is filled.
+type Slot = (Mutex<Option<Result<Analysis, PhysicsError>>>, Condvar);
+
+/// An [`analyze`](super::analyze) of one assembly, running on its own
+/// thread (with a pool of one worker, so that it never holds a worker of
+/// the shared pool the step check needs). Its clones share it; dropping
+/// the last one stops the solver at its next iteration.
+#[derive(Debug, Clone)]
+pub struct Pending(Arc<Inner>);
+
+#[derive(Debug)]
+struct Inner {
+    pieces: usize,
+    since: Instant,
+    stop: Arc<AtomicBool>,
+    answer: Arc<Slot>,
+}
+
+impl Pending {
+    /// Starts the analysis of `assembly` (a copy of it is taken).
+    pub fn start(assembly: &Assembly, params: &Params) -> Pending {
+        let stop = Arc::new(AtomicBool::new(false));
+        let answer: Arc<Slot> = Arc::new((Mutex::new(None), Condvar::new()));
+        let (asm, params) = (assembly.clone(), *params);
+        let (flag, slot) = (Arc::clone(&stop), Arc::clone(&answer));
+        std::thread::spawn(move || {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                analyze_stopping(&asm, &params, flag)
+            }))
+            .unwrap_or_else(|_| {
+                Err(PhysicsError::Bug(
+                    "the finished model's analysis panicked".into(),
+                ))
+            });
+            let (lock, signal) = &*slot;
+            *lock
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
+            signal.notify_all();
+        });
+        Pending(Arc::new(Inner {
+            pieces: assembly.pieces.len(),
+            since: Instant::now(),
+            stop,
+            answer,
+        }))
+    }
+
+    /// The pieces of the assembly analysed.
+    pub fn pieces(&self) -> usize {
+        self.0.pieces
+    }
+
+    /// When it started.
+    pub fn since(&self) -> Instant {
+        self.0.since
+    }
+
+    /// Whether the model stands, once its analysis is made (`None` until
+    /// then, or when it failed: [`Pending::wait`] says why).
+    pub fn stands(&self) -> Option<bool> {
+        let (lock, _) = &*self.0.answer;
+        let slot = lock
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        slot.as_ref()
+            .and_then(|r| r.as_ref().ok())
+            .map(Analysis::stands)
+    }
+
+    /// Its answer, once made (blocking until then).
+    pub fn wait(&self) -> Result<Analysis, PhysicsError> {
+        self.wait_until(None)
+            .expect("no deadline: the answer comes")
+    }
+
+    /// Its answer, if made by `deadline` (`None`: waits until it is).
+    pub fn wait_until(&self, deadline: Option<Instant>) -> Option<Result<Analysis, PhysicsError>> {
+        let (lock, signal) = &*self.0.answer;
+        let mut slot = lock
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        loop {
+            if let Some(r) = slot.as_ref() {
+                return Some(r.clone());
+            }
+            slot = match deadline {
+                None => signal
+                    .wait(slot)
+                    .unwrap_or_else(std::sync::PoisonError::into_inner),
+                Some(d) => {
+                    let left = d.saturating_duration_since(Instant::now());
+                    if left.is_zero() {
+                        return None;
+                    }
+                    signal
+                        .wait_timeout(slot, left)
+                        .unwrap_or_else(std::sync::PoisonError::into_inner)
+                        .0
+                }
+            };
+        }
+    }
+}
+
+impl Drop for Inner {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+}
+
+/// [`analyze`](super::analyze), its solver stopped once `stop` is set,
+/// on a pool of one worker of its own.
+fn analyze_stopping(
+    assembly: &Assembly,
+    params: &Params,
+    stop: Arc<AtomicBool>,
+) -> Result<Analysis, PhysicsError> {
+    let start = Instant::now();
+    params.check()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| PhysicsError::Bug(format!("a thread for the finished model: {e}")))?;
+    let mut s = Structure::new(assembly, params);
+    s.stop = Some(stop);
+    let pieces = pool.install(|| steps::solve_all(&s, assembly.pieces.len(), params))?;
+    Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
+}
