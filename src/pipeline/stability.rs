@@ -104,10 +104,12 @@ pub struct StepRow {
 pub struct Before {
     /// The first step at which something would fall or break off.
     pub first_failure: Option<u32>,
-    /// The finished model's lowest score.
-    pub min_score: f64,
-    /// The finished model stands.
-    pub final_stands: bool,
+    /// The finished model's lowest score; `None` when it was not
+    /// analysed: support columns went in first (the analysis of the model
+    /// without them, made on a core of its own, is stopped then).
+    pub min_score: Option<f64>,
+    /// The finished model stands (`None`: not analysed, as above).
+    pub final_stands: Option<bool>,
 }
 
 /// The `stability` section of `report.json`.
@@ -208,8 +210,8 @@ pub fn settle(
     )?;
     let mut before = Before {
         first_failure: first.check.first_failure,
-        min_score: 0.0,
-        final_stands: false,
+        min_score: None,
+        final_stands: None,
     };
     let mut best = first;
     // How the finished model stood before repairs, for the report: its
@@ -228,6 +230,9 @@ pub fn settle(
     // Support columns first: they keep the model's own layout.
     let mut shored = Shoring::default();
     if supports && mode == Stability::Repair && best.check.first_failure.is_some() {
+        // The model without columns, if not analysed yet, is not: one
+        // program at a time beside the check.
+        unrepaired = unrepaired.filter(Result::is_ok);
         shored = support(&mut best, params, deadline, &mut counts)?;
     }
     if mode == Stability::Repair && best.check.first_failure.is_some() {
@@ -307,15 +312,15 @@ pub fn settle(
                 pending.wait()?
             }
         };
-        before.min_score = f.min_score;
-        before.final_stands = f.stands();
+        before.min_score = Some(f.min_score);
+        before.final_stands = Some(f.stands());
     }
     // The order repair was tried on the first layout while its finished
     // model's analysis was being made: only one that stands has an order
     // to repair (another layout's was known before its repair).
     let order_tried = best
         .order_tried
-        .filter(|_| reseeded.is_some() || before.final_stands);
+        .filter(|_| reseeded.is_some() || before.final_stands == Some(true));
     if mode == Stability::Repair && before.first_failure.is_some() {
         match (&best.order_fix, order_tried) {
             (Some(moved), _) => repairs.push(format!(
