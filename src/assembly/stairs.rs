@@ -86,9 +86,43 @@ struct Column {
     high_piece: usize,
 }
 
-/// Counts the stair edges of `asm` on its top and underside, and how many
-/// are capped (see the module docs).
-pub fn stair_edges(asm: &Assembly) -> StairEdges {
+/// The most stair edges of `asm` that straight slopes could cap, on top
+/// and underneath: one a column, since a slope faces one way. A column
+/// that steps down two ways (a corner of a hip or of a rounded top) or
+/// both ways (a ridge one stud wide) has stair edges no slope of the
+/// alphabet caps all of; corner and ridge slopes would.
+///
+/// ```
+/// use brickwright::assembly::{stairs, Assembly, Placement};
+/// use brickwright::catalog::{Color, PartKind};
+/// use brickwright::geom::{Cell, Rot};
+///
+/// // A 1x1 brick on the middle of a 1x3: one column, two stair edges,
+/// // at most one capped.
+/// let brick = |id: &str, x, z| Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0);
+/// let asm = Assembly::from_order(&[brick("3622", 0, 0), brick("3005", 1, 1)], 24, Color::RED);
+/// assert_eq!(stairs::stair_edges(&asm).edges.top, 2);
+/// assert_eq!(stairs::cappable_at_most(&asm).top, 1);
+/// ```
+pub fn cappable_at_most(asm: &Assembly) -> TopUnder {
+    let cols = columns(asm);
+    let u = asm.layer_ldu.max(1);
+    let is_step = |layers: i32| (8..=24).contains(&(layers * u));
+    let mut out = TopUnder::default();
+    for (&(x, y), a) in &cols {
+        let near = || {
+            [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .into_iter()
+                .filter_map(|d: (i32, i32)| cols.get(&(x + d.0, y + d.1)))
+        };
+        out.top += usize::from(near().any(|b| is_step(a.high - b.high)));
+        out.underside += usize::from(near().any(|b| is_step(b.low - a.low)));
+    }
+    out
+}
+
+/// Every column of `asm`'s cells, by its (x, y).
+fn columns(asm: &Assembly) -> HashMap<(i32, i32), Column> {
     let mut cols: HashMap<(i32, i32), Column> = HashMap::new();
     for (i, p) in asm.pieces.iter().enumerate() {
         for c in p.placement.body(asm.layer_ldu).cells() {
@@ -106,6 +140,13 @@ pub fn stair_edges(asm: &Assembly) -> StairEdges {
             }
         }
     }
+    cols
+}
+
+/// Counts the stair edges of `asm` on its top and underside, and how many
+/// are capped (see the module docs).
+pub fn stair_edges(asm: &Assembly) -> StairEdges {
+    let cols = columns(asm);
     let u = asm.layer_ldu.max(1);
     let is_step = |layers: i32| (8..=24).contains(&(layers * u));
     // The piece faces from column `a` towards its neighbour at `dir`: its

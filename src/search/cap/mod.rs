@@ -18,7 +18,10 @@
 //! rather than a 45° 2x2 slope, a 2x4 and a 2x3. What is left of the brick
 //! is laid as few bricks of the alphabet as fill it (no 1x1s), and those
 //! are capped again where they stand a step above their neighbours too (a
-//! ridge brick gets slopes on both sides). Roofs are capped from the eaves
+//! ridge brick gets slopes on both sides). A brick with something on part
+//! of its side's row (half under the next course, as on the rounded tops
+//! of organic models) has the longest bare run of that row capped instead,
+//! the rest of the row laid as bricks beside the slopes. Roofs are capped from the eaves
 //! up, so that a slope's front row lies on the back row of the slope
 //! capped just below it.
 //!
@@ -104,6 +107,62 @@ fn rest_box(b: &CellBox, d: (i32, i32), rows: i32) -> Option<Option<CellBox>> {
             ..*b
         },
     }))
+}
+
+/// What is left of brick box `b` when a run of its side facing `d` (the
+/// side cells from `lo`, `len` of them along the side) has its `rows` rows
+/// made slopes: the rows behind the side, and the side's rows on either
+/// side of the run; `None` if the brick is not `rows` deep.
+fn rest_boxes(b: &CellBox, d: (i32, i32), rows: i32, lo: Cell, len: i32) -> Option<Vec<CellBox>> {
+    let mut out: Vec<CellBox> = rest_box(b, d, rows)?.into_iter().collect();
+    // The side's rows: the brick less the rows behind them.
+    let strip = match d {
+        (1, 0) => CellBox {
+            min: b.min.offset(b.sx - rows, 0, 0),
+            sx: rows,
+            ..*b
+        },
+        (-1, 0) => CellBox { sx: rows, ..*b },
+        (0, 1) => CellBox {
+            min: b.min.offset(0, b.sy - rows, 0),
+            sy: rows,
+            ..*b
+        },
+        _ => CellBox { sy: rows, ..*b },
+    };
+    // Along the side: y when it faces x, x otherwise.
+    if d.0 != 0 {
+        let (before, after) = (lo.y - strip.min.y, strip.min.y + strip.sy - (lo.y + len));
+        if before > 0 {
+            out.push(CellBox {
+                sy: before,
+                ..strip
+            });
+        }
+        if after > 0 {
+            out.push(CellBox {
+                min: Cell::new(strip.min.x, lo.y + len, strip.min.z),
+                sy: after,
+                ..strip
+            });
+        }
+    } else {
+        let (before, after) = (lo.x - strip.min.x, strip.min.x + strip.sx - (lo.x + len));
+        if before > 0 {
+            out.push(CellBox {
+                sx: before,
+                ..strip
+            });
+        }
+        if after > 0 {
+            out.push(CellBox {
+                min: Cell::new(lo.x + len, strip.min.y, strip.min.z),
+                sx: after,
+                ..strip
+            });
+        }
+    }
+    Some(out)
 }
 
 /// How many pieces the walk that checks a swap keeps the build joined
@@ -455,8 +514,26 @@ impl Layout<'_> {
             .filter(|&(k, _)| k > 0)
             .collect();
         sides.sort_by_key(|&(k, d)| (std::cmp::Reverse(k), d));
-        for (steps, d) in sides {
-            if let Some((k, rest)) = self.swap_side(id, d, kind, steps, budget) {
+        let mut runs: Vec<(usize, (i32, i32), Vec<Cell>)> = sides
+            .iter()
+            .map(|&(k, d)| (k, d, self.side_cells(&b, d).collect()))
+            .collect();
+        // Then the bare runs of the sides with something on part of their
+        // row (a brick half under the next course): the run's rows become
+        // slopes, the rest of the side's rows bricks.
+        let mut part: Vec<(usize, (i32, i32), Vec<Cell>)> = DIRS
+            .iter()
+            .filter(|&&d| !self.side_bare(&b, d, up))
+            .filter_map(|&d| {
+                let run = self.best_bare_run(&b, d, up)?;
+                Some((self.steps_of(&run, d, &b, up), d, run))
+            })
+            .filter(|(k, _, _)| *k > 0)
+            .collect();
+        part.sort_by_key(|(k, d, _)| (std::cmp::Reverse(*k), *d));
+        runs.extend(part);
+        for (steps, d, side) in runs {
+            if let Some((k, rest)) = self.swap_side(id, d, &side, kind, steps, budget) {
                 let mut more = 0;
                 if depth < MAX_DEPTH {
                     for r in rest {
@@ -475,11 +552,49 @@ impl Layout<'_> {
     /// (under it, underneath when `up` is false), nor is any voxel of the
     /// model left there uncovered.
     fn side_bare(&self, b: &CellBox, d: (i32, i32), up: bool) -> bool {
+        self.side_cells(b, d).all(|a| self.bare_over(a, b, up))
+    }
+
+    /// Whether nothing lies on side cell `a` of brick box `b` (under it
+    /// when `up` is false), nor any voxel of the model left uncovered.
+    fn bare_over(&self, a: Cell, b: &CellBox, up: bool) -> bool {
         let dz = if up { b.sz } else { -1 };
-        self.side_cells(b, d).all(|a| {
-            let q = a.offset(0, 0, dz);
-            !self.must.in_bounds(q) || (self.owner_of(q).is_none() && !self.must.get(q))
-        })
+        let q = a.offset(0, 0, dz);
+        !self.must.in_bounds(q) || (self.owner_of(q).is_none() && !self.must.get(q))
+    }
+
+    /// The longest run of the side of `b` facing `d` with nothing over
+    /// (under) it, at least two cells and not the whole side; the first of
+    /// the longest.
+    fn best_bare_run(&self, b: &CellBox, d: (i32, i32), up: bool) -> Option<Vec<Cell>> {
+        let side: Vec<Cell> = self.side_cells(b, d).collect();
+        let mut best: Option<(usize, usize)> = None;
+        let mut at = 0;
+        while at < side.len() {
+            if !self.bare_over(side[at], b, up) {
+                at += 1;
+                continue;
+            }
+            let start = at;
+            while at < side.len() && self.bare_over(side[at], b, up) {
+                at += 1;
+            }
+            let len = at - start;
+            if len >= 2 && len < side.len() && best.is_none_or(|(_, l)| len > l) {
+                best = Some((start, len));
+            }
+        }
+        let (start, len) = best?;
+        Some(side[start..start + len].to_vec())
+    }
+
+    /// How many of the side cells `run` of brick box `b` have a neighbour
+    /// facing `d` that steps a brick down, with room for a slope's front
+    /// row (see [`Layout::side_steps`]).
+    fn steps_of(&self, run: &[Cell], d: (i32, i32), b: &CellBox, up: bool) -> usize {
+        run.iter()
+            .filter(|&&a| self.steps_down(a, d, b, up))
+            .count()
     }
 
     /// How many columns of the side of `b` facing `d` have a neighbour
@@ -489,25 +604,30 @@ impl Layout<'_> {
     /// the same upside down.
     fn side_steps(&self, b: &CellBox, d: (i32, i32), up: bool) -> usize {
         self.side_cells(b, d)
-            .filter(|&a| {
-                let n = a.offset(d.0, d.1, 0);
-                if up {
-                    // Front row at the brick's bottom layer, open above,
-                    // resting on a piece.
-                    let f = Cell::new(n.x, n.y, b.min.z);
-                    self.free_cell(f)
-                        && self.clear_column(f, 1)
-                        && self.owner_of(f.offset(0, 0, -1)).is_some()
-                } else {
-                    // Front row at the brick's top layer, open below,
-                    // holding a piece above.
-                    let f = Cell::new(n.x, n.y, b.min.z + b.sz - 1);
-                    self.free_cell(f)
-                        && self.clear_column(f, -1)
-                        && self.owner_of(f.offset(0, 0, 1)).is_some()
-                }
-            })
+            .filter(|&a| self.steps_down(a, d, b, up))
             .count()
+    }
+
+    /// Whether side cell `a` of brick box `b` has a neighbour facing `d`
+    /// that steps a brick down, with room for a slope's front row (see
+    /// [`Layout::side_steps`]).
+    fn steps_down(&self, a: Cell, d: (i32, i32), b: &CellBox, up: bool) -> bool {
+        let n = a.offset(d.0, d.1, 0);
+        if up {
+            // Front row at the brick's bottom layer, open above,
+            // resting on a piece.
+            let f = Cell::new(n.x, n.y, b.min.z);
+            self.free_cell(f)
+                && self.clear_column(f, 1)
+                && self.owner_of(f.offset(0, 0, -1)).is_some()
+        } else {
+            // Front row at the brick's top layer, open below,
+            // holding a piece above.
+            let f = Cell::new(n.x, n.y, b.min.z + b.sz - 1);
+            self.free_cell(f)
+                && self.clear_column(f, -1)
+                && self.owner_of(f.offset(0, 0, 1)).is_some()
+        }
     }
 
     /// The bottom-layer cells of `b` along its side facing `d`.
@@ -561,20 +681,20 @@ impl Layout<'_> {
         &mut self,
         id: u32,
         d: (i32, i32),
+        side: &[Cell],
         kind: Shape,
         steps: usize,
         budget: &mut Budget,
     ) -> Option<(usize, Vec<u32>)> {
         let p = self.pieces[id as usize];
         let b = p.body.bbox;
-        let side: Vec<Cell> = self.side_cells(&b, d).collect();
         // 45° slopes (their back row on the side row) and 33° ones (their
         // back two rows in the brick): the plan that adds the fewest pieces
         // first, then the 45° one.
         let mut plans: Vec<(usize, i32, Vec<Part>, usize)> = [2, 3]
             .into_iter()
             .filter_map(|deep| {
-                let (slopes, rest) = self.plan_swap(&b, d, kind, &side, deep)?;
+                let (slopes, rest) = self.plan_swap(&b, d, kind, side, deep)?;
                 let n = slopes.len();
                 let all: Vec<(Placement, Body)> = slopes.into_iter().chain(rest).collect();
                 Some((all.len(), deep, all, n))
@@ -639,9 +759,19 @@ impl Layout<'_> {
         side: &[Cell],
         deep: i32,
     ) -> Option<(Vec<Part>, Vec<Part>)> {
-        let rest = match rest_box(b, d, deep - 1)? {
-            Some(r) => self.bricks_for(&r)?,
-            None => Vec::new(),
+        let whole = side.len() as i32 == if d.0 != 0 { b.sy } else { b.sx };
+        let rest = if whole {
+            match rest_box(b, d, deep - 1)? {
+                Some(r) => self.bricks_for(&r)?,
+                None => Vec::new(),
+            }
+        } else {
+            let boxes = rest_boxes(b, d, deep - 1, *side.first()?, side.len() as i32)?;
+            let mut v = Vec::new();
+            for r in boxes {
+                v.extend(self.bricks_for(&r)?);
+            }
+            v
         };
         Some((self.slope_row(side, d, kind, deep)?, rest))
     }
@@ -934,5 +1064,44 @@ mod tests {
         );
         assert_eq!(rest_box(&b, (0, 1), 2), Some(None));
         assert_eq!(rest_box(&b, (0, 1), 3), None);
+    }
+
+    #[test]
+    fn the_rest_of_a_brick_capped_along_a_run_of_its_side() {
+        // A 1x6 brick along x whose +y side is capped on x 12..14 only (a
+        // brick lies on the rest of its row): no rows behind the side,
+        // 1x2 before the run and 1x2 after it.
+        let b = brick(6, 1);
+        let at = |x| Cell::new(x, 20, 4);
+        assert_eq!(
+            rest_boxes(&b, (0, 1), 1, at(12), 2),
+            Some(vec![
+                CellBox { sx: 2, ..b },
+                CellBox {
+                    min: at(14),
+                    sx: 2,
+                    ..b
+                },
+            ])
+        );
+        // A 2x4 brick along x, its -y side capped on x 10..12: the row
+        // behind (4 long), then the side row past the run (2 long).
+        let b = brick(4, 2);
+        assert_eq!(
+            rest_boxes(&b, (0, -1), 1, at(10), 2),
+            Some(vec![
+                CellBox {
+                    min: Cell::new(10, 21, 4),
+                    sy: 1,
+                    ..b
+                },
+                CellBox {
+                    min: at(12),
+                    sx: 2,
+                    sy: 1,
+                    ..b
+                },
+            ])
+        );
     }
 }
