@@ -16,6 +16,15 @@ use super::{model::Structure, steps, Analysis, Params, PhysicsError};
 /// The answer's slot, and the signal that it is filled.
 type Slot = (Mutex<Option<Result<Analysis, PhysicsError>>>, Condvar);
 
+/// Puts `r` in `slot` and says so to whoever waits.
+fn fill(slot: &Slot, r: Result<Analysis, PhysicsError>) {
+    let (lock, signal) = slot;
+    *lock
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
+    signal.notify_all();
+}
+
 /// An [`analyze`](super::analyze) of one assembly, running on its own
 /// thread (with a pool of one worker, so that it never holds a worker of
 /// the shared pool the step check needs). Its clones share it; dropping
@@ -38,21 +47,23 @@ impl Pending {
         let answer: Arc<Slot> = Arc::new((Mutex::new(None), Condvar::new()));
         let (asm, params) = (assembly.clone(), *params);
         let (flag, slot) = (Arc::clone(&stop), Arc::clone(&answer));
-        std::thread::spawn(move || {
-            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                analyze_stopping(&asm, &params, flag)
-            }))
-            .unwrap_or_else(|_| {
-                Err(PhysicsError::Bug(
-                    "the finished model's analysis panicked".into(),
-                ))
+        let spawned = std::thread::Builder::new()
+            .name("finished model".into())
+            .spawn(move || {
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    analyze_stopping(&asm, &params, flag)
+                }))
+                .unwrap_or_else(|_| {
+                    Err(PhysicsError::Bug(
+                        "the finished model's analysis panicked".into(),
+                    ))
+                });
+                fill(&slot, r);
             });
-            let (lock, signal) = &*slot;
-            *lock
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(r);
-            signal.notify_all();
-        });
+        if let Err(e) = spawned {
+            let why = format!("no thread for the finished model's analysis: {e}");
+            fill(&answer, Err(PhysicsError::Bug(why)));
+        }
         Pending(Arc::new(Inner {
             pieces: assembly.pieces.len(),
             since: Instant::now(),
@@ -141,4 +152,50 @@ fn analyze_stopping(
     s.stop = Some(stop);
     let pieces = pool.install(|| steps::solve_all(&s, assembly.pieces.len(), params))?;
     Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Placement;
+    use crate::catalog::{Color, PartKind};
+    use crate::geom::{Cell, Rot};
+
+    /// A 1x4 on the table, and a 1x6 clutched to its end, hanging past
+    /// it with nothing to balance it: it breaks off.
+    fn overhang() -> Assembly {
+        let at = |id: &str, x, z| {
+            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
+        };
+        Assembly::from_order(&[at("3010", 0, 0), at("3009", 3, 1)], 24, Color::RED)
+    }
+
+    #[test]
+    fn a_pending_analysis_is_the_analysis_and_its_clones_share_it() {
+        let (asm, params) = (overhang(), Params::default());
+        let whole = super::super::analyze(&asm, &params).unwrap();
+        let p = Pending::start(&asm, &params);
+        let q = p.clone();
+        assert_eq!(p.pieces(), 2);
+        let made = p.wait().unwrap();
+        assert_eq!(made.pieces, whole.pieces);
+        assert_eq!(q.stands(), Some(whole.stands()));
+        assert!(!whole.stands(), "{whole:?}");
+        // Made: a deadline passed long ago still gets it.
+        let again = q.wait_until(Some(p.since())).unwrap().unwrap();
+        assert_eq!(again.pieces, whole.pieces);
+    }
+
+    #[test]
+    fn a_dropped_pending_analysis_stops() {
+        let stop = Arc::new(AtomicBool::new(true));
+        // Stopped before it starts: the solver gives up at its first
+        // iteration, and says so.
+        let r = analyze_stopping(&overhang(), &Params::default(), stop);
+        assert!(matches!(r, Err(PhysicsError::Solver { .. })), "{r:?}");
+        let p = Pending::start(&overhang(), &Params::default());
+        let flag = Arc::clone(&p.0.stop);
+        drop(p);
+        assert!(flag.load(Ordering::Relaxed));
+    }
 }
