@@ -24,7 +24,17 @@
 //! The layout's extras are not used here: no slope guide, no colour
 //! splits, no pieces outside the voxels; every piece fills voxels of the
 //! model only, as in the paper.
+//!
+//! One repair is made first, where pieces stack by more than one layer
+//! (with slopes, two half-brick layers): a column of voxels that ends half
+//! a course off, where no slope's low row can end it, gets the half course
+//! added ([`courses`]; counted in `evened_voxels`, as the layout's evening
+//! is). Every piece of a build stands a whole number of courses above the
+//! lowest layer, so such a column is in no derivation: the house's ridge
+//! at 11 studs with slopes, 17 half layers high, was one. For the same
+//! reason the parts are cut on whole courses only.
 
+mod courses;
 mod draw;
 mod fit;
 mod joinable;
@@ -50,8 +60,10 @@ pub const CUT_RATIO: f64 = 1.5;
 /// The parts of `v`: ranges of layers `[lo, hi)`, bottom first, cut where
 /// a layer's voxel count changes by [`CUT_RATIO`] or more from the one
 /// below, each part at least `min_layers` high and one piece (face to
-/// face) on its own.
-pub fn parts(v: &VoxelGrid, min_layers: i32) -> Vec<(i32, i32)> {
+/// face) on its own. Cuts fall a whole number of `step`s of layers above
+/// the lowest (the height pieces stack by: a part cut through a course
+/// would leave half a brick that no piece of it can fill).
+pub fn parts(v: &VoxelGrid, min_layers: i32, step: i32) -> Vec<(i32, i32)> {
     let (_, _, nz) = v.dims();
     let counts: Vec<usize> = (0..nz).map(|z| v.count_layer(z)).collect();
     let lo = counts.iter().position(|&c| c > 0).unwrap_or(0) as i32;
@@ -64,7 +76,7 @@ pub fn parts(v: &VoxelGrid, min_layers: i32) -> Vec<(i32, i32)> {
             continue;
         }
         let sharp = a.max(b) / a.min(b) >= CUT_RATIO;
-        if sharp && z - last >= min_layers && hi - z >= min_layers {
+        if sharp && (z - lo) % step.max(1) == 0 && z - last >= min_layers && hi - z >= min_layers {
             let below = slab(v, last, z);
             let above = slab(v, z, hi);
             if one_piece(&below) && one_piece(&above) {
@@ -118,14 +130,15 @@ fn one_piece(v: &VoxelGrid) -> bool {
 
 /// Traces `voxels` (already repaired: `repairs`) backward, part by part.
 pub(super) fn build(
-    voxels: VoxelGrid,
-    repairs: Repairs,
+    mut voxels: VoxelGrid,
+    mut repairs: Repairs,
     emptied: Option<VoxelGrid>,
     rules: &RuleSet,
     opts: &SearchOptions,
     started: Instant,
 ) -> Result<SearchOutcome, SearchError> {
     let book = RuleBook::new(rules);
+    let shapes = trace::coverers(rules);
     let tuning = Tuning {
         b_min: opts.branching.0,
         b_max: opts.branching.1.max(opts.branching.0),
@@ -133,12 +146,30 @@ pub(super) fn build(
         node_budget: opts.node_budget,
         restart: opts.restart,
         deadline: started + opts.time_budget,
+        step: courses::step(&shapes),
+        base: voxels.bounds().map_or(0, |b| b.min.z),
     };
     // Parts at least a brick high (a course: 1 layer for bricks, more for
     // slopes or plates).
     let course = (24 / rules.layer_ldu()).max(1);
+    // Every column of voxels ends on a whole course, or where a slope can
+    // end it: a half course is added where neither is so (the ridge of a
+    // roof of half courses), and a column that still cannot be filled
+    // fails at once.
+    repairs.evened_voxels += courses::even(&mut voxels, &shapes);
+    if let Some(c) = courses::uneven(&voxels, &shapes) {
+        return Err(SearchError::Backward {
+            why: format!(
+                "the column of voxels at ({}, {}) ends at layer {} between two courses, where no slope can end it and no half course can be added: these rules cannot build the shape",
+                c.x, c.y, c.z
+            ),
+            nodes: 0,
+            backtracks: 0,
+            secs: started.elapsed().as_secs_f64(),
+        });
+    }
     let cuts = if opts.cut {
-        parts(&voxels, 2 * course)
+        parts(&voxels, 2 * course, tuning.step)
     } else {
         vec![(0, voxels.dims().2)]
     };
@@ -260,8 +291,10 @@ mod tests {
                 }
             }
         }
-        assert_eq!(parts(&v, 2), [(0, 2), (2, 6)]);
+        assert_eq!(parts(&v, 2, 1), [(0, 2), (2, 6)]);
         // Parts must be two layers high at least: no cut at 1.
-        assert_eq!(parts(&v, 5), [(0, 6)]);
+        assert_eq!(parts(&v, 5, 1), [(0, 6)]);
+        // Nor where it falls inside a step of three layers.
+        assert_eq!(parts(&v, 2, 3), [(0, 6)]);
     }
 }

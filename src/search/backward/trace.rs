@@ -63,6 +63,11 @@ pub(super) struct Tuning {
     /// searched again from its root; 0 never.
     pub restart: u64,
     pub deadline: Instant,
+    /// The height pieces stack by, in layers ([`super::courses::step`]),
+    /// and the lowest layer of the whole shape: every piece of a build
+    /// has its bottom a whole number of steps above it.
+    pub step: i32,
+    pub base: i32,
 }
 
 /// Counters shared by every part's trace.
@@ -442,6 +447,8 @@ pub(super) struct Trace<'a> {
     draws: RefCell<Draws>,
     /// The rules by shape.
     index: VariantIndex,
+    /// The shape's voxels: this part's and the parts' below.
+    model: VoxelGrid,
 }
 
 /// A piece's share of a state's hash (`salt` 1: matched, 2: taken).
@@ -482,6 +489,7 @@ impl<'a> Trace<'a> {
             built.set(c, true);
         }
         let layer = rules.layer_ldu();
+        let model = built.clone();
         let ground: Vec<Placement> = below_pieces
             .iter()
             .filter(|p| {
@@ -513,6 +521,7 @@ impl<'a> Trace<'a> {
             built: RefCell::new(built),
             air: RefCell::new(None),
             shapes: coverers(rules),
+            model,
             widen: 1,
             hash: 0,
             failed: HashSet::new(),
@@ -587,6 +596,7 @@ impl<'a> Trace<'a> {
         let mut exhausted: HashSet<u64> = HashSet::new();
         let root = self.frame(rng, count, None);
         let mut stack = vec![root];
+        let mut ticks = 0u64;
         loop {
             if let Some(last) = self.finished() {
                 return Ok(Pass::Found(self.derivation(&log, last)));
@@ -603,7 +613,10 @@ impl<'a> Trace<'a> {
                 }
                 return Ok(Pass::CutShort);
             }
-            if count.nodes.is_multiple_of(64) && Instant::now() >= self.tuning.deadline {
+            // Counted in turns of this loop, not in nodes: where most
+            // children are cut at once, nodes come slowly.
+            ticks += 1;
+            if ticks.is_multiple_of(64) && Instant::now() >= self.tuning.deadline {
                 return Err(Stop::Time);
             }
             let Some(top) = stack.last_mut() else {
@@ -835,7 +848,20 @@ impl<'a> Trace<'a> {
             .iter()
             .map(|&(part, rot)| self.body(&Placement::new(part, Cell::new(0, 0, 0), rot)))
             .collect();
-        let free_at: Vec<VoxelGrid> = probes.iter().map(|p| self.open.fits(p.boxes())).collect();
+        let free_at: Vec<VoxelGrid> = probes
+            .iter()
+            .map(|p| {
+                let mut g = self.open.fits(p.boxes());
+                if !p.is_box() {
+                    for o in g.clone().cells() {
+                        if !self.clear_face(&p.moved(o.x, o.y, o.z)) {
+                            g.set(o, false);
+                        }
+                    }
+                }
+                g
+            })
+            .collect();
         let mut stay_at: Vec<Option<VoxelGrid>> = vec![None; ix.shapes.len()];
         let mut pending_at: Vec<Option<VoxelGrid>> = vec![None; ix.shapes.len()];
         for (set, of) in [
@@ -1025,7 +1051,16 @@ impl<'a> Trace<'a> {
 
     /// Whether every cell of `b` is left and not held by a pending piece.
     fn free(&self, b: &Body) -> bool {
-        b.boxes().iter().all(|bx| self.open.all_set(bx))
+        b.boxes().iter().all(|bx| self.open.all_set(bx)) && self.clear_face(b)
+    }
+
+    /// Whether no voxel of the shape lies in the cells of `b`'s box that
+    /// it does not fill (a slope's sloping face passes through them): a
+    /// piece there would meet the face, and the verifier refuses pieces
+    /// whose boxes overlap. Every voxel is some piece's, so a slope stands
+    /// only where the shape is empty over its low rows.
+    fn clear_face(&self, b: &Body) -> bool {
+        b.is_box() || face_cells(b).all(|c| !self.model.get(c))
     }
 
     /// Sets [`Trace::open`] again over the cells of `b`, from `left` and
@@ -1060,7 +1095,8 @@ impl<'a> Trace<'a> {
                 for y in 0..ny {
                     for x in 0..nx {
                         let p = Placement::new(part, Cell::new(x, y, z), rot);
-                        if self.free(&self.body(&p)) {
+                        let b = self.body(&p);
+                        if self.on_step(&b) && self.free(&b) {
                             out.push(p);
                         }
                     }
@@ -1498,7 +1534,7 @@ impl<'a> Trace<'a> {
             let found = self.shapes.iter().find_map(|s| {
                 s.cells().find_map(|q| {
                     let b = s.moved(c.x - q.x, c.y - q.y, c.z - q.z);
-                    self.covers(&b).then_some(b)
+                    (self.on_step(&b) && self.covers(&b)).then_some(b)
                 })
             });
             match found {
@@ -1509,6 +1545,15 @@ impl<'a> Trace<'a> {
             }
         }
         None
+    }
+
+    /// Whether the piece `b` stands a whole number of steps above the
+    /// shape's lowest layer, as every piece of a build does (pieces join
+    /// only by studs): with slopes, a brick half a course off is in no
+    /// derivation, and a cell only such a brick could cover is a dead end.
+    fn on_step(&self, b: &Body) -> bool {
+        let t = &self.tuning;
+        (b.bbox.min.z - t.base).rem_euclid(t.step.max(1)) == 0
     }
 
     /// Whether the piece `b` could be taken away as it stands: its cells
@@ -1605,6 +1650,11 @@ impl<'a> Trace<'a> {
         }
         out
     }
+}
+
+/// The cells of `b`'s box it does not fill: where a slope's face passes.
+fn face_cells(b: &Body) -> impl Iterator<Item = Cell> + '_ {
+    b.bbox.cells().filter(|&c| !b.contains(c))
 }
 
 /// The bodies of the alphabet's pieces at the origin, every distinct turn.

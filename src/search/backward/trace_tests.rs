@@ -47,6 +47,8 @@ fn tuning() -> Tuning {
         node_budget: 1_000_000,
         restart: 0,
         deadline: Instant::now() + Duration::from_secs(60),
+        step: 1,
+        base: 0,
     }
 }
 
@@ -258,5 +260,7 @@ fn listing_the_rules_that_match_agrees_with_trying_each() {
         t.apply(&c);
         steps += 1;
     }
-    assert!(steps >= 8, "{steps} steps");
+    // (Six: a slope whose face would meet a voxel left over its low row
+    // is no match, so the path drawn here ends sooner than it did.)
+    assert!(steps >= 6, "{steps} steps");
 }
