@@ -258,9 +258,11 @@ fn the_house_with_slopes_is_evened_to_whole_courses_and_traced() {
         .restricted(|p| p.spec().family() != Family::Plate)
         .unwrap();
     let grid = fixture_voxels("house.obj", 11, &rules);
+    // Bounded by nodes, not time (7,397 nodes, a few seconds alone; ten
+    // times that beside the rest of the tests).
     let opts = backward(5)
-        .with_node_budget(300_000)
-        .with_time_budget(std::time::Duration::from_secs(120));
+        .with_node_budget(100_000)
+        .with_time_budget(std::time::Duration::from_secs(3600));
     let out = search::build(&grid, &rules, &opts).unwrap();
     assert_eq!(out.repairs.evened_voxels, 22);
     assert_eq!(out.stats.parts, 1);

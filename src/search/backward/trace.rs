@@ -624,6 +624,11 @@ impl<'a> Trace<'a> {
             };
             let mut child = None;
             while child.is_none() {
+                // A node may go through many rules before one matches.
+                ticks += 1;
+                if ticks.is_multiple_of(64) && Instant::now() >= self.tuning.deadline {
+                    return Err(Stop::Time);
+                }
                 if top.next == top.tries.len() && !self.draw_next(top, rng) {
                     break;
                 }
