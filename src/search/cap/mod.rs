@@ -130,36 +130,32 @@ fn rest_boxes(b: &CellBox, d: (i32, i32), rows: i32, lo: Cell, len: i32) -> Opti
         },
         _ => CellBox { sy: rows, ..*b },
     };
-    // Along the side: y when it faces x, x otherwise.
-    if d.0 != 0 {
-        let (before, after) = (lo.y - strip.min.y, strip.min.y + strip.sy - (lo.y + len));
-        if before > 0 {
-            out.push(CellBox {
-                sy: before,
-                ..strip
-            });
-        }
-        if after > 0 {
-            out.push(CellBox {
-                min: Cell::new(strip.min.x, lo.y + len, strip.min.z),
-                sy: after,
-                ..strip
-            });
-        }
+    // Along the side (y when it faces x, x otherwise): the side's rows
+    // before the run and after it.
+    let along_y = d.0 != 0;
+    let (start, size, at) = if along_y {
+        (strip.min.y, strip.sy, lo.y)
     } else {
-        let (before, after) = (lo.x - strip.min.x, strip.min.x + strip.sx - (lo.x + len));
-        if before > 0 {
-            out.push(CellBox {
-                sx: before,
+        (strip.min.x, strip.sx, lo.x)
+    };
+    let part = |from: i32, n: i32| {
+        if along_y {
+            CellBox {
+                min: Cell::new(strip.min.x, from, strip.min.z),
+                sy: n,
                 ..strip
-            });
+            }
+        } else {
+            CellBox {
+                min: Cell::new(from, strip.min.y, strip.min.z),
+                sx: n,
+                ..strip
+            }
         }
-        if after > 0 {
-            out.push(CellBox {
-                min: Cell::new(lo.x + len, strip.min.y, strip.min.z),
-                sx: after,
-                ..strip
-            });
+    };
+    for (from, n) in [(start, at - start), (at + len, start + size - (at + len))] {
+        if n > 0 {
+            out.push(part(from, n));
         }
     }
     Some(out)
