@@ -240,10 +240,12 @@ pub fn settle(
         // step (after its own order repair) is kept, else the best tried.
         let mut tried = 0;
         // Another layout is worth its search only if its finished model
-        // can be analysed by the deadline (about as long as this one's).
-        let analysis = best.analysis_time();
+        // can be analysed by the deadline (about as long as this one's,
+        // which must be made by then: while it is being made, how long it
+        // takes is not known).
+        let analysis = best.analysis_time_by(params, deadline, &mut counts)?;
         for k in 1..=RESEEDS {
-            if Instant::now() + analysis >= deadline {
+            if analysis.is_none_or(|a| Instant::now() + a >= deadline) {
                 break;
             }
             tried += 1;
@@ -461,6 +463,34 @@ impl Attempt {
             (None, None) => 0.0,
         };
         Duration::from_secs_f64(secs.clamp(0.0, 1e9))
+    }
+
+    /// How long the finished model's analysis took, once it is made by
+    /// `deadline` (started if it is not being made, and waited for until
+    /// then); `None` if it is not made by then.
+    fn analysis_time_by(
+        &mut self,
+        params: &Params,
+        deadline: Instant,
+        counts: &mut Counts,
+    ) -> Result<Option<Duration>, crate::pipeline::BuildError> {
+        if self.finished.is_none() {
+            let pending = self
+                .pending
+                .take()
+                .unwrap_or_else(|| Pending::start(&self.plan.1, params));
+            match pending.wait_until(Some(deadline)) {
+                Some(made) => {
+                    counts.solves += 1;
+                    self.finished = Some(made?);
+                }
+                None => {
+                    self.pending = Some(pending);
+                    return Ok(None);
+                }
+            }
+        }
+        Ok(Some(self.analysis_time()))
     }
 
     /// The finished model's analysis for a step check: known, or being
