@@ -679,19 +679,11 @@ fn check_steps_in(
                 reused += 1;
             } else if !job.grounded || k == last_k && fin.covers_last() {
                 late.push(job);
+            } else if take_certificate(&mut cert, job, begin, &mut current, &mut exact) {
+                certified += 1;
             } else {
-                let new: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
-                match cert.certify(job, &new) {
-                    Verdict::Stands(stress) => {
-                        for (&p, st) in job.pieces.iter().zip(stress) {
-                            current[p] = st;
-                            exact[p] = false;
-                        }
-                        certified += 1;
-                    }
-                    // The program's answer says which pieces fail.
-                    Verdict::Fails | Verdict::Unknown => late.push(job),
-                }
+                // The program's answer says which pieces fail.
+                late.push(job);
             }
         }
         if k == last_k && fin.covers_last() {
@@ -705,17 +697,12 @@ fn check_steps_in(
                     // group another equilibrium holds within every
                     // capacity: its answer certifies only a group it
                     // holds, and the others are certified as any step's.
-                    if job.grounded && job.pieces.iter().any(|&p| whole[p].fails()) {
-                        let new: Vec<usize> =
-                            job.pieces.iter().copied().filter(|&p| p >= begin).collect();
-                        if let Verdict::Stands(stress) = cert.certify(job, &new) {
-                            for (&p, st) in job.pieces.iter().zip(stress) {
-                                current[p] = st;
-                                exact[p] = false;
-                            }
-                            certified += 1;
-                            continue;
-                        }
+                    if job.grounded
+                        && job.pieces.iter().any(|&p| whole[p].fails())
+                        && take_certificate(&mut cert, job, begin, &mut current, &mut exact)
+                    {
+                        certified += 1;
+                        continue;
                     }
                     for &p in &job.pieces {
                         current[p] = whole[p];
@@ -812,6 +799,28 @@ fn check_steps_in(
         finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
         map: drawn,
     })
+}
+
+/// Certifies `job` (its pieces from `begin` on are new) by the kept
+/// equilibrium changed near the new pieces: when one is found, its
+/// pieces' stress goes into `current`, not exact (one equilibrium of
+/// many), and true is returned.
+fn take_certificate(
+    cert: &mut Certifier,
+    job: &Job,
+    begin: usize,
+    current: &mut [PieceStress],
+    exact: &mut [bool],
+) -> bool {
+    let new: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
+    let Verdict::Stands(stress) = cert.certify(job, &new) else {
+        return false;
+    };
+    for (&p, st) in job.pieces.iter().zip(stress) {
+        current[p] = st;
+        exact[p] = false;
+    }
+    true
 }
 
 /// The check of one intermediate build from its pieces' stress.
