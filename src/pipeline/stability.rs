@@ -496,17 +496,14 @@ impl Attempt {
     /// The finished model's analysis for a step check: known, or being
     /// made.
     fn finish(&self) -> Finish<'_> {
-        match (&self.finished, &self.pending) {
-            (Some(f), _) => Finish::Known(f),
-            (None, Some(p)) => Finish::Pending(p),
-            (None, None) => Finish::WhenDue,
-        }
+        finish_of(self.finished.as_ref(), self.pending.as_ref())
     }
 
-    /// Takes the finished model's analysis from its check, when that
-    /// made it or waited for it.
-    fn take_finished(&mut self, counts: &mut Counts) {
-        if let Some(f) = self.check.finished.take() {
+    /// Takes the finished model's analysis from a check of it (`check`,
+    /// or its own when `None`), when that made it or waited for it.
+    fn take_finished(&mut self, check: Option<&mut StepsAnalysis>, counts: &mut Counts) {
+        let made = check.unwrap_or(&mut self.check).finished.take();
+        if let Some(f) = made {
             if self.finished.is_none() {
                 self.finished = Some(f);
                 if self.pending.take().is_some() {
@@ -599,11 +596,7 @@ fn attempt(
             Some(deadline),
             1,
             tell,
-            match (&finished, &pending) {
-                (Some(f), _) => Finish::Known(f),
-                (None, Some(p)) => Finish::Pending(p),
-                (None, None) => Finish::WhenDue,
-            },
+            finish_of(finished.as_ref(), pending.as_ref()),
         )?,
         plan,
         partial: false,
@@ -614,7 +607,7 @@ fn attempt(
         supports: Vec::new(),
     };
     counts.add(&at.check);
-    at.take_finished(counts);
+    at.take_finished(None, counts);
     at.partial = stopped_early(&at.plan.1, &at.check);
     let in_time = Instant::now() < deadline;
     // The order repair, unless the finished model is known to fail (no
@@ -664,6 +657,16 @@ fn attempt(
         }
     }
     Ok(at)
+}
+
+/// The finished model's analysis for a step check: `finished` when known,
+/// else `pending` when it is being made, else made when due.
+fn finish_of<'a>(finished: Option<&'a Analysis>, pending: Option<&'a Pending>) -> Finish<'a> {
+    match (finished, pending) {
+        (Some(f), _) => Finish::Known(f),
+        (None, Some(p)) => Finish::Pending(p),
+        (None, None) => Finish::WhenDue,
+    }
 }
 
 /// Keeps the order repair `r` in `at`, whose check of it is `c`.
@@ -749,14 +752,7 @@ fn check_the_rest(
             best.finish(),
         )?;
         counts.add(&c);
-        if let Some(f) = c.finished.take() {
-            if best.finished.is_none() {
-                best.finished = Some(f);
-                if best.pending.take().is_some() {
-                    counts.solves += 1;
-                }
-            }
-        }
+        best.take_finished(Some(&mut c), counts);
         if c.first_failure.is_some() {
             best.check = spliced(&best.check, from, c);
             best.partial = false;
