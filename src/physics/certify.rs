@@ -100,6 +100,9 @@ pub(super) struct Certifier<'a> {
     pub found: [usize; RINGS.len() + 1],
     /// Pieces in the regions of the certificates found, summed.
     pub region_pieces: usize,
+    /// A region's program past this gives no answer (see
+    /// [`Certifier::until`]).
+    deadline: Option<std::time::Instant>,
 }
 
 /// One unknown of a region's program: which force, where, and how it acts.
@@ -145,7 +148,16 @@ impl<'a> Certifier<'a> {
             placed_to: 0,
             found: [0; RINGS.len() + 1],
             region_pieces: 0,
+            deadline: None,
         }
+    }
+
+    /// Stops each region's program at `deadline`: one not solved by then
+    /// gives no answer ([`Verdict::Unknown`], for the caller's budget to
+    /// settle), so a big group's program never runs far past it.
+    pub(super) fn until(mut self, deadline: Option<std::time::Instant>) -> Self {
+        self.deadline = deadline;
+        self
     }
 
     /// Places piece `p`: its contacts with placed pieces may carry forces.
@@ -659,6 +671,12 @@ impl<'a> Certifier<'a> {
         let Ok(mut solver) = DefaultSolver::new(&pm, &cost, &a, &b, &cones, settings) else {
             return Found::Trouble;
         };
+        if let Some(deadline) = self.deadline {
+            if std::time::Instant::now() >= deadline {
+                return Found::Trouble;
+            }
+            solver.set_termination_callback(move |_| std::time::Instant::now() >= deadline);
+        }
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
@@ -726,5 +744,54 @@ fn sign(v: &Var, p: usize) -> f64 {
         -up
     } else {
         up
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{Assembly, Placement};
+    use crate::catalog::{Color, PartKind};
+    use crate::geom::{Cell, Rot};
+
+    /// A 1x4 base, a 1x2 counterweight on its one end and a 1x6 clutched
+    /// to its other end, hanging past it: held by clutch, so only a
+    /// program finds its forces.
+    fn counterweighted() -> Assembly {
+        let at = |id: &str, x, z| {
+            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
+        };
+        let order = [at("3010", 0, 0), at("3004", 0, 1), at("3009", 3, 1)];
+        Assembly::from_order(&order, 24, Color::RED)
+    }
+
+    /// The verdict on the whole build, placed at once.
+    fn verdict(deadline: Option<std::time::Instant>) -> Verdict {
+        let params = Params::default();
+        let asm = counterweighted();
+        let s = Structure::new(&asm, &params);
+        let mut cert = Certifier::new(&s, &params).until(deadline);
+        cert.place_to(asm.pieces.len());
+        let mut groups = cert.groups_with(&[0, 1, 2]);
+        assert_eq!(groups.len(), 1);
+        let (job, new) = groups.remove(0);
+        cert.certify(&job, &new)
+    }
+
+    #[test]
+    fn a_regions_program_past_the_deadline_gives_no_answer() {
+        // In time (or with no deadline), the clutch is found.
+        let later = std::time::Instant::now() + std::time::Duration::from_secs(3600);
+        for deadline in [None, Some(later)] {
+            let Verdict::Stands(stress) = verdict(deadline) else {
+                panic!("the counterweighted build stands");
+            };
+            assert!(stress.iter().any(|p| p.usage > 0.0), "{stress:?}");
+        }
+        // Past it, no program runs: neither stands nor fails is said.
+        assert!(matches!(
+            verdict(Some(std::time::Instant::now())),
+            Verdict::Unknown
+        ));
     }
 }

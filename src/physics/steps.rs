@@ -602,7 +602,7 @@ fn check_steps_in(
         biggest: None,
     };
     let mut begin = 0;
-    let mut cert = Certifier::new(s, params);
+    let mut cert = Certifier::new(s, params).until(deadline);
     let mut complete = true;
     let total = bounds.len() as u64;
     for (k, &(step, end)) in bounds.iter().enumerate() {
