@@ -42,10 +42,10 @@ use super::{Params, PieceStress};
 const CAP: f64 = 1.0 - 1e-6;
 
 /// Rings of contacts around the new pieces tried before the whole group.
-const RINGS: [usize; 4] = [0, 1, 2, 4];
+const RINGS: [usize; 5] = [0, 1, 2, 4, 8];
 
 /// A ring holding this share of the group is the whole group.
-const WHOLE_SHARE: f64 = 0.5;
+const WHOLE_SHARE: f64 = 0.9;
 
 /// The directions on the table in which the group's outermost grounded
 /// pieces join the region (see [`Certifier::ways_to_footing`]).
