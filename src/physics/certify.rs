@@ -750,20 +750,7 @@ fn sign(v: &Var, p: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{Assembly, Placement};
-    use crate::catalog::{Color, PartKind};
-    use crate::geom::{Cell, Rot};
-
-    /// A 1x4 base, a 1x2 counterweight on its one end and a 1x6 clutched
-    /// to its other end, hanging past it: held by clutch, so only a
-    /// program finds its forces.
-    fn counterweighted() -> Assembly {
-        let at = |id: &str, x, z| {
-            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
-        };
-        let order = [at("3010", 0, 0), at("3004", 0, 1), at("3009", 3, 1)];
-        Assembly::from_order(&order, 24, Color::RED)
-    }
+    use crate::physics::fixtures::counterweighted;
 
     /// The verdict on the whole build, placed at once.
     fn verdict(deadline: Option<std::time::Instant>) -> Verdict {

@@ -155,6 +155,25 @@ pub mod repair;
 mod steps;
 pub mod support;
 
+/// Builds for the unit tests of the physics and the stages that use it.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use crate::assembly::{Assembly, Placement};
+    use crate::catalog::{Color, PartKind};
+    use crate::geom::{Cell, Rot};
+
+    /// A 1x4 base, a 1x2 counterweight on its one end and a 1x6 clutched
+    /// to its other end, hanging past it: it stands, on clutch (only a
+    /// program finds its forces).
+    pub(crate) fn counterweighted() -> Assembly {
+        let at = |id: &str, x, z| {
+            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
+        };
+        let order = [at("3010", 0, 0), at("3004", 0, 1), at("3009", 3, 1)];
+        Assembly::from_order(&order, 24, Color::RED)
+    }
+}
+
 use serde::Serialize;
 
 #[cfg(doc)]

@@ -1218,16 +1218,7 @@ mod tests {
     use super::*;
     use crate::catalog::PartKind;
     use crate::geom::{Cell, Rot};
-
-    /// A 1x4 base, a 1x2 counterweight on its one end and a 1x6 clutched
-    /// to its other end, hanging past it: it stands, on clutch.
-    fn counterweighted() -> Assembly {
-        let at = |id: &str, x, z| {
-            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
-        };
-        let order = [at("3010", 0, 0), at("3004", 0, 1), at("3009", 3, 1)];
-        Assembly::from_order(&order, 24, Color::RED)
-    }
+    use crate::physics::fixtures::counterweighted;
 
     #[test]
     fn the_finished_models_map_is_the_programs_once_or_the_certificates_past_the_budget() {
