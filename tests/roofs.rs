@@ -131,15 +131,7 @@ fn check_roof(path: &Path, studs: u32, min_share: f64) {
     // slopes a layer is half a brick, so a brick is twice the voxels): 89%
     // on the house at 11 studs, 92-104% on the others (85-91% before the
     // long slopes); and no more 1x1s.
-    let vpp = |a: &Assembly, per_brick: i32| {
-        let cells: i32 = a
-            .pieces
-            .iter()
-            .map(|p| p.placement.body(a.layer_ldu).volume())
-            .sum();
-        f64::from(cells) / f64::from(per_brick) / a.pieces.len() as f64
-    };
-    let (p, q) = (vpp(&plain, 1), vpp(&sloped, 2));
+    let (p, q) = (bricks_a_piece(&plain, 1), bricks_a_piece(&sloped, 2));
     assert!(
         q >= 0.88 * p,
         "{}: {q:.2} bricks a piece against {p:.2}",

@@ -51,7 +51,7 @@ fn open_ends(v: &VoxelGrid, shapes: &[Body], step: i32, end: End) -> Vec<Cell> {
     let base = v.bounds().map_or(0, |b| b.min.z);
     off_step_ends(v, step, end)
         .into_iter()
-        .filter(|&c| !short_column_ends(v, shapes, step, base, c, end))
+        .filter(|&c| short_column_piece(v, shapes, step, base, c, end, None).is_none())
         .collect()
 }
 
@@ -88,19 +88,6 @@ fn off_step_ends(v: &VoxelGrid, step: i32, end: End) -> Vec<Cell> {
         }
     }
     out
-}
-
-/// Whether some piece of `shapes` lying wholly in `v`, its bottom at a
-/// step, has a column that ends (at its `end`) at `c`.
-fn short_column_ends(
-    v: &VoxelGrid,
-    shapes: &[Body],
-    step: i32,
-    base: i32,
-    c: Cell,
-    end: End,
-) -> bool {
-    short_column_piece(v, shapes, step, base, c, end, None).is_some()
 }
 
 /// The first piece of `shapes` lying wholly in `v` and in no cell of

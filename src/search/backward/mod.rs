@@ -157,16 +157,18 @@ pub(super) fn build(
     // roof of half courses), and a column that still cannot be filled
     // fails at once.
     repairs.evened_voxels += courses::even(&mut voxels, &shapes);
+    // A shape refused before any node is searched.
+    let refused = |why: String| SearchError::Backward {
+        why,
+        nodes: 0,
+        backtracks: 0,
+        secs: started.elapsed().as_secs_f64(),
+    };
     if let Some(c) = courses::uneven(&voxels, &shapes) {
-        return Err(SearchError::Backward {
-            why: format!(
-                "the column of voxels at ({}, {}) ends at layer {} between two courses, where no slope can end it and no half course can be added: these rules cannot build the shape",
-                c.x, c.y, c.z
-            ),
-            nodes: 0,
-            backtracks: 0,
-            secs: started.elapsed().as_secs_f64(),
-        });
+        return Err(refused(format!(
+            "the column of voxels at ({}, {}) ends at layer {} between two courses, where no slope can end it and no half course can be added: these rules cannot build the shape",
+            c.x, c.y, c.z
+        )));
     }
     let cuts = if opts.cut {
         parts(&voxels, 2 * course, tuning.step)
@@ -176,15 +178,10 @@ pub(super) fn build(
     // A shape whose voxels no pieces in them can hold together fails at
     // once, not when the budget ends.
     if let Some((c, n)) = joinable::unjoinable(&voxels, rules) {
-        return Err(SearchError::Backward {
-            why: format!(
-                "no pieces in the voxels can join the {n} voxels from ({}, {}, {}) to the rest (they touch it only along edges, or across a layer no piece spans): these rules cannot build the shape",
-                c.x, c.y, c.z
-            ),
-            nodes: 0,
-            backtracks: 0,
-            secs: started.elapsed().as_secs_f64(),
-        });
+        return Err(refused(format!(
+            "no pieces in the voxels can join the {n} voxels from ({}, {}, {}) to the rest (they touch it only along edges, or across a layer no piece spans): these rules cannot build the shape",
+            c.x, c.y, c.z
+        )));
     }
     let (nx, ny, nz) = voxels.dims();
     let mut below = VoxelGrid::new(nx, ny, nz);
