@@ -120,6 +120,39 @@ fn a_cantilever_holds_at_a_short_reach_and_breaks_at_a_long_one() {
     assert!(long.pieces[2].usage < 1e-4);
 }
 
+/// The long cantilever above (its arm's joint at 1.21 of its clutch), with
+/// its load also hung from a 2x6 beam on a post beside it by a chain of
+/// four 1x1 bricks. The force program's least usage leaves the whole load
+/// on the arm, overloaded (the chain's joints and the post's cost more in
+/// its sum than the arm's one joint saves), though the chain can take the
+/// excess: another equilibrium holds every joint within its capacity, so
+/// the model stands (the safe theorem), its stress the least usage within
+/// capacity, the arm's joint at it.
+#[test]
+fn a_model_another_equilibrium_holds_within_capacity_stands() {
+    let params = Params::default().with_ground(Ground::Baseplate);
+    let (h, chain) = (15, 4);
+    let mut p: Vec<P> = vec![("3001", 0, 0, 0, R0, 1), ("3007", 3, 0, 1, R0, 2)];
+    for k in 0..h {
+        p.push(("3001", 9, -1, 2 + k, R90, 3));
+    }
+    for k in 0..chain {
+        p.push(("3005", 9, 0, 2 + h + k, R0, 4));
+    }
+    for z in 0..2 + h + chain {
+        p.push(("3003", 13, 0, z, R0, 5));
+    }
+    p.push(("2456", 9, 0, 2 + h + chain, R0, 6));
+    let a = analyze(&build(&p), &params).unwrap();
+    assert!(a.stands(), "{a:?}");
+    assert!(a.max_usage <= 1.0, "{}", a.max_usage);
+    // The arm takes all it can; the chain the rest.
+    assert!(close(a.pieces[1].usage, 1.0, 1e-3), "{}", a.pieces[1].usage);
+    // Without the chain and the post it breaks off, as above.
+    let alone = analyze(&cantilever("3007", 8, 15), &params).unwrap();
+    assert!(!alone.stands() && alone.pieces[1].breaks);
+}
+
 /// Two 1x2 columns two bricks high at x 0..2 and 16..18 on a table, a 1x8
 /// arm on each reaching for the middle (one stud on its column), and a
 /// 1x4 keystone across the arms' ends; `steps` are the seven pieces'

@@ -34,12 +34,8 @@ use clarabel::solver::{
 };
 
 use super::groups::Job;
-use super::model::{Rect, Structure};
+use super::model::{Rect, Structure, CAP};
 use super::{Params, PieceStress};
-
-/// The most a stud carries in a certificate: just under its capacity
-/// (a usage of 1 breaks the joint).
-const CAP: f64 = 1.0 - 1e-6;
 
 /// Rings of contacts around the new pieces tried before the whole group.
 const RINGS: [usize; 5] = [0, 1, 2, 4, 8];

@@ -385,14 +385,54 @@ fn spread(cols: usize, joints: &[(usize, Option<usize>, usize)], spread: f64) ->
     CscMatrix::new(cols, cols, colptr, rowval, nzval)
 }
 
+/// The most a joint carries in the program held within capacity: just
+/// under a stud's capacity (a usage of 1 breaks the joint).
+pub(super) const CAP: f64 = 1.0 - 1e-6;
+
 /// Solves the group `pieces` (sorted) with the `contacts` among them.
+///
+/// The program's least usage may overload a joint (a usage of 1 or more)
+/// where another equilibrium holds every joint within its capacity: the
+/// sum it minimises trades one joint's excess for less at others. So the
+/// program is also solved with every joint held to [`CAP`]: where that
+/// needs no hand, the group stands (the safe theorem), and that answer,
+/// the least usage within capacity, is its stress (the same as the first
+/// program's wherever that overloads nothing: the cost is strictly convex
+/// in the usages); else the first answer says which joints are
+/// overloaded and by how much. With `held_first` (a group expected to
+/// stand: a finished model) the program within capacity is solved first,
+/// and the other only if it needs a hand; else (a group a step's
+/// certificate failed) the other first, and the one within capacity only
+/// if it breaks a joint with no hand.
 pub(super) fn solve(
     s: &Structure,
     pieces: &[usize],
     contacts: &[&Contact],
     params: &Params,
+    held_first: bool,
 ) -> Result<Solved, PhysicsError> {
-    solve_propped(s, pieces, contacts, params, None)
+    let within = Props {
+        props: &[],
+        cap: CAP,
+    };
+    if held_first {
+        let held = solve_propped(s, pieces, contacts, params, Some(&within))?;
+        if !held.stress.iter().any(PieceStress::fails) {
+            return Ok(held);
+        }
+        return solve_propped(s, pieces, contacts, params, None);
+    }
+    let first = solve_propped(s, pieces, contacts, params, None)?;
+    let breaks = first.stress.iter().any(|p| p.breaks);
+    if !breaks || first.stress.iter().any(|p| p.falls) {
+        return Ok(first);
+    }
+    let held = solve_propped(s, pieces, contacts, params, Some(&within))?;
+    Ok(if held.stress.iter().any(PieceStress::fails) {
+        first
+    } else {
+        held
+    })
 }
 
 /// [`solve`], where `props` may also push pieces up and every joint's

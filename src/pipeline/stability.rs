@@ -213,6 +213,16 @@ pub fn settle(
         min_score: None,
         final_stands: None,
     };
+    // A first check that failed at the last step has checked the finished
+    // model: it fails, and its analysis there is the check's last.
+    let last_step = first.plan.1.pieces.last().map(|p| p.step.0);
+    if before.first_failure.is_some()
+        && before.first_failure == last_step
+        && first.check.last.pieces.len() == first.plan.1.pieces.len()
+    {
+        before.min_score = Some(first.check.last.min_score);
+        before.final_stands = Some(false);
+    }
     let mut best = first;
     // How the finished model stood before repairs, for the report: its
     // analysis may still be being made (on a core of its own, while the
@@ -307,15 +317,19 @@ pub fn settle(
         }
     }
     if let Some(first) = unrepaired.take() {
+        // Not made by the deadline, it is left out of the report.
         let f = match first {
-            Ok(known) => known,
+            Ok(known) => Some(known),
             Err(pending) => {
-                counts.solves += 1;
-                pending.wait()?
+                let made = pending.wait_until(Some(deadline)).transpose()?;
+                counts.solves += usize::from(made.is_some());
+                made
             }
         };
-        before.min_score = Some(f.min_score);
-        before.final_stands = Some(f.stands());
+        if let Some(f) = f {
+            before.min_score = Some(f.min_score);
+            before.final_stands = Some(f.stands());
+        }
     }
     // The order repair was tried on the first layout while its finished
     // model's analysis was being made: only one that stands has an order
