@@ -1,9 +1,10 @@
 //! The finished model's analysis on a thread of its own: started as soon
 //! as the model is known, waited for only where its answer is needed, and
 //! stopped when the model it was made for is given up (a repair changed
-//! it). The step check waits for it at its last step, as for an analysis
-//! made alongside ([`Finish::Pending`](super::Finish::Pending)); a check
-//! that stops at an earlier failure leaves it running.
+//! it). The step check certifies its last step without it
+//! ([`Finish::Pending`](super::Finish::Pending)) and waits for it only when
+//! cut short by its deadline; a check that stops at an earlier failure
+//! leaves it running.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};

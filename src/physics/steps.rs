@@ -368,8 +368,9 @@ pub enum Finish<'a> {
     /// Known already.
     Known(&'a Analysis),
     /// Being made on a thread of its own, since before the check: the
-    /// last step waits for it; a check that stops before the last step
-    /// leaves it running (and [`StepsAnalysis::finished`] empty).
+    /// last step is certified without it, and only a check cut short by
+    /// its deadline waits for it; otherwise it is left running (and
+    /// [`StepsAnalysis::finished`] empty).
     Pending(&'a Pending),
 }
 

@@ -598,9 +598,9 @@ fn attempt(
     finished: Option<Analysis>,
 ) -> Result<Attempt, crate::pipeline::BuildError> {
     // The finished model is analysed on a core of its own from the start,
-    // unless known: the check waits for it at its last step only, and a
-    // check that stops at an earlier failure goes on to the repairs
-    // while it is made.
+    // unless known: the check certifies its last step without it (the map
+    // and the repairs wait for it, within the deadline), and a check that
+    // stops at an earlier failure goes on to the repairs while it is made.
     let pending = finished.is_none().then(|| Pending::start(&plan.1, params));
     let mut at = Attempt {
         check: analyze_steps_verdicts(
