@@ -76,12 +76,11 @@
 //! - **Within capacity**: the least sum may load one joint past its
 //!   capacity to spare others, where another equilibrium holds every
 //!   joint within it (the bunny at 72 studs: a joint at 1.34 in a model
-//!   that stands). So the program is also solved with `m_j <= 1 - 1e-6`
-//!   for every joint: where no hand is needed then, the group stands (the
-//!   safe theorem) and that answer, the least usage within capacity, is
-//!   its stress (the first program's wherever that overloads nothing);
-//!   else the first program's answer names the overloaded joints and by
-//!   how much. A finished model gets the program within capacity first.
+//!   that stands). So a group whose answer breaks a joint and needs no
+//!   hand is solved again with `m_j <= 1 - 1e-6` for every joint: if no
+//!   hand is needed then either, the group stands (the safe theorem) and
+//!   that answer, the least usage within capacity, is its stress; else the
+//!   first answer stands, naming the overloaded joints and by how much.
 //!
 //! Pieces that touch nowhere form separate groups (connected components,
 //! compression contacts included); each is its own program. A group that

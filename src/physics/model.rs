@@ -393,40 +393,30 @@ pub(super) const CAP: f64 = 1.0 - 1e-6;
 ///
 /// The program's least usage may overload a joint (a usage of 1 or more)
 /// where another equilibrium holds every joint within its capacity: the
-/// sum it minimises trades one joint's excess for less at others. So the
-/// program is also solved with every joint held to [`CAP`]: where that
-/// needs no hand, the group stands (the safe theorem), and that answer,
-/// the least usage within capacity, is its stress (the same as the first
-/// program's wherever that overloads nothing: the cost is strictly convex
-/// in the usages); else the first answer says which joints are
-/// overloaded and by how much. With `held_first` (a group expected to
-/// stand: a finished model) the program within capacity is solved first,
-/// and the other only if it needs a hand; else (a group a step's
-/// certificate failed) the other first, and the one within capacity only
-/// if it breaks a joint with no hand.
+/// sum it minimises trades one joint's excess for less at others. So a
+/// group whose answer breaks a joint, and needs no hand, is solved again
+/// with every joint held to [`CAP`]: if that needs no hand either, the
+/// group stands (the safe theorem), and that answer, the least usage
+/// within capacity, is its stress; else the first answer says which
+/// joints are overloaded and by how much. (Solving the program within
+/// capacity first, for a finished model, took the bunny at 96 studs,
+/// which fails, from 425 s to about 17 minutes: with a hand to find, it
+/// is far slower.)
 pub(super) fn solve(
     s: &Structure,
     pieces: &[usize],
     contacts: &[&Contact],
     params: &Params,
-    held_first: bool,
 ) -> Result<Solved, PhysicsError> {
-    let within = Props {
-        props: &[],
-        cap: CAP,
-    };
-    if held_first {
-        let held = solve_propped(s, pieces, contacts, params, Some(&within))?;
-        if !held.stress.iter().any(PieceStress::fails) {
-            return Ok(held);
-        }
-        return solve_propped(s, pieces, contacts, params, None);
-    }
     let first = solve_propped(s, pieces, contacts, params, None)?;
     let breaks = first.stress.iter().any(|p| p.breaks);
     if !breaks || first.stress.iter().any(|p| p.falls) {
         return Ok(first);
     }
+    let within = Props {
+        props: &[],
+        cap: CAP,
+    };
     let held = solve_propped(s, pieces, contacts, params, Some(&within))?;
     Ok(if held.stress.iter().any(PieceStress::fails) {
         first

@@ -91,14 +91,8 @@ fn past(deadline: Option<Instant>) -> bool {
 }
 
 /// Solves the jobs in parallel, in order: each job's stress per piece,
-/// how it was found and the seconds its solve took; `held_first` as
-/// [`solve`] takes it (for the groups of a structure solved whole).
-fn run_refs(
-    s: &Structure,
-    jobs: &[&Job],
-    params: &Params,
-    held_first: bool,
-) -> Result<Vec<Answer>, PhysicsError> {
+/// how it was found and the seconds its solve took.
+fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
             if !job.grounded {
@@ -117,7 +111,7 @@ fn run_refs(
             }
             let contacts: Vec<&Contact> = job.contacts.iter().map(|&k| &s.contacts[k]).collect();
             let start = Instant::now();
-            solve(s, &job.pieces, &contacts, params, held_first)
+            solve(s, &job.pieces, &contacts, params)
                 .map(|r| (r.stress, Found::Solved, start.elapsed().as_secs_f64()))
         })
         .collect()
@@ -157,7 +151,7 @@ fn solve_all_but(
             _ => todo.push(job),
         }
     }
-    let results = run_refs(s, &todo, params, true)?;
+    let results = run_refs(s, &todo, params)?;
     for (job, (r, _, _)) in todo.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
@@ -732,7 +726,7 @@ fn check_steps_in(
             complete = false;
             break;
         }
-        let results = run_refs(s, &late, params, false)?;
+        let results = run_refs(s, &late, params)?;
         solves += results.iter().filter(|r| r.1 == Found::Solved).count();
         certified += results.iter().filter(|r| r.1 == Found::Certified).count();
         for (job, (r, found, secs)) in late.iter().zip(results) {
