@@ -402,7 +402,14 @@ struct Finisher<'a, 'scope> {
     state: State<'a>,
     /// Whether its programs were solved here.
     made: bool,
-    /// Whether it was given made ([`Finisher::given`]).
+    /// Whether it was given made ([`Finish::Known`]): the last step's
+    /// groups take its answers, exact and at no cost. Else the last step
+    /// is certified as every other step is, without waiting for it: the
+    /// finished model's program can take far longer than the rest of the
+    /// check (the bunny at 72 studs with its support columns, 4,998
+    /// pieces: 152 s, the steps' certificates 45 s), and a verdict that
+    /// came from whichever of the two ended first would change with the
+    /// machine's load.
     given: bool,
     /// Whether programs spawned now run beside the check: it is not on a
     /// worker of the pool (whose own queue would hold them until the
@@ -461,18 +468,6 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
     /// Whether the last step takes its answers: it is made, or being made.
     fn covers_last(&self) -> bool {
         !matches!(self.state, State::Due)
-    }
-
-    /// Whether it was given made ([`Finish::Known`]): the last step's
-    /// groups take its answers, exact and at no cost. Else the last step
-    /// is certified as every other step is, without waiting for it: the
-    /// finished model's program can take far longer than the rest of the
-    /// check (the bunny at 72 studs with its support columns, 4,998
-    /// pieces: 152 s, the steps' certificates 45 s), and a verdict that
-    /// came from whichever of the two ended first would change with the
-    /// machine's load.
-    fn given(&self) -> bool {
-        self.given
     }
 
     /// The time by which the check stops (see [`Reserve::cut`]): when the
@@ -694,7 +689,7 @@ fn check_steps_in(
                     exact[p] = false;
                 }
                 reused += 1;
-            } else if !job.grounded || k == last_k && fin.given() {
+            } else if !job.grounded || k == last_k && fin.given {
                 late.push(job);
             } else if take_certificate(&mut cert, job, begin, &mut current, &mut exact) {
                 certified += 1;
@@ -703,7 +698,7 @@ fn check_steps_in(
                 late.push(job);
             }
         }
-        if k == last_k && fin.given() {
+        if k == last_k && fin.given {
             if let Some((whole, secs)) = fin.wait()? {
                 // The finished model's groups: its answers, exact.
                 if !late.is_empty() {
