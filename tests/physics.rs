@@ -10,7 +10,7 @@ use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
 use brickwright::physics::{
     analyze, analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_with_finished,
-    analyze_steps_within, Ground, Params, CLUTCH_N, GRAVITY,
+    analyze_steps_within, Ground, Params, StressMap, CLUTCH_N, GRACE, GRAVITY,
 };
 
 use Rot::{R0, R90};
@@ -381,6 +381,23 @@ fn a_check_cut_short_makes_the_finished_model_alongside_the_steps() {
             assert_eq!(f.pieces, whole.pieces);
         }
     }
+}
+
+/// A check cut short whose finished model is not made within the grace
+/// after its deadline does not wait for it: its `last` is the steps
+/// checked (none here: the deadline passed long before the check began),
+/// and its map says so.
+#[test]
+fn a_check_cut_short_past_its_grace_does_not_wait_for_the_finished_model() {
+    let params = Params::default();
+    let asm = fixture_build("house.obj", 24);
+    let long_ago = std::time::Instant::now() - 2 * GRACE;
+    let c = analyze_steps_within(&asm, &params, false, Some(long_ago)).unwrap();
+    assert!(!c.complete);
+    assert!(c.steps.is_empty());
+    assert!(c.last.pieces.is_empty(), "{}", c.last.pieces.len());
+    assert_eq!(c.map, StressMap::Checked);
+    assert!(c.finished.is_none());
 }
 
 #[test]

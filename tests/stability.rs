@@ -12,7 +12,7 @@ use brickwright::assembly::verify::verify;
 use brickwright::assembly::{Assembly, Placed, Placement, Step};
 use brickwright::catalog::{Color, PartKind};
 use brickwright::geom::{Cell, Rot};
-use brickwright::physics::repair::reorder;
+use brickwright::physics::repair::{reorder, reorder_while, MAX_REPAIRED_STEP};
 use brickwright::physics::{analyze_steps, Params};
 use serde_json::Value;
 
@@ -430,4 +430,40 @@ fn the_order_repair_stops_once_a_deferred_piece_is_shut_in() {
     late.pieces.insert(5, overhang);
     assert!(!verify(&late, None).is_ok());
     assert!(reorder(&asm, &params, 2, None).unwrap().is_none());
+}
+
+#[test]
+fn the_order_repair_gives_up_once_more_pieces_wait_than_a_step_may_hold() {
+    // The overhang of `overhang_first` tips its base at step 2, and a
+    // column of 1x1 bricks goes up from its far end, one a step: each
+    // hangs on the overhang, so each waits with it, and nothing later
+    // ever stands. The walk gives up once more pieces wait than a
+    // repaired step may hold, rather than walk every step of the column.
+    let piece = |id: &str, x: i32, z: i32, step: u32| Placed {
+        placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0),
+        step: Step(step),
+        color: Color::RED,
+    };
+    let column = 3 * MAX_REPAIRED_STEP as i32;
+    let mut pieces = vec![piece("3010", 0, 0, 1), piece("3009", 3, 1, 2)];
+    pieces.extend((0..column).map(|k| piece("3005", 8, 2 + k, 3 + k as u32)));
+    let asm = Assembly {
+        pieces,
+        layer_ldu: 24,
+    };
+    assert!(verify(&asm, None).is_ok(), "{}", verify(&asm, None));
+    let params = Params::default();
+    let trials = std::cell::Cell::new(0);
+    let go = || {
+        trials.set(trials.get() + 1);
+        true
+    };
+    assert!(reorder_while(&asm, &params, 2, &go).unwrap().is_none());
+    // One trial or two a step (the step, then without what fails), up to
+    // the step where too many wait: about a third of the column.
+    assert!(
+        trials.get() <= 2 * (MAX_REPAIRED_STEP + 2),
+        "{} trials for a column of {column}",
+        trials.get()
+    );
 }

@@ -109,16 +109,24 @@ pub fn build_summary(r: &BuildReport, out_dir: &Path) {
 
 /// The stability lines of the build summary.
 fn print_build_stability(st: &StabilityReport) {
-    let verdict = match (st.first_failure, st.complete) {
-        (None, true) => "stands at every step".to_string(),
-        (None, false) => format!(
+    // Cut short before the finished model was analysed: the scores are
+    // the steps checked.
+    let unknown = st.stress_map == brickwright::physics::StressMap::Checked;
+    let verdict = match (st.first_failure, st.complete, unknown) {
+        (None, true, _) => "stands at every step".to_string(),
+        (None, false, false) => format!(
             "checked {} steps before its time budget ran out; they and the finished model stand",
             st.steps_checked
         ),
-        (Some(step), _) => format!("does not stand from step {step} on"),
+        (None, false, true) => format!(
+            "checked {} steps before its time budget ran out; they stand, and the finished model was not analysed in time",
+            st.steps_checked
+        ),
+        (Some(step), _, _) => format!("does not stand from step {step} on"),
     };
     outln!(
-        "  stability: {verdict}; finished model: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} {})",
+        "  stability: {verdict}; {}: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} {})",
+        if unknown { "steps checked" } else { "finished model" },
         st.min_score,
         st.mean_score,
         st.solves,

@@ -119,16 +119,21 @@
 //! more: that compression is added to the kept forces. For every other
 //! group the kept equilibrium is changed near the new pieces: a small
 //! program over the new pieces, a way down from each to the ground and
-//! a few rings of contacts around them, widened up to the whole group,
-//! where the program is exact: none found there, the step fails, and the
-//! group's force program below says which pieces fall or break off. The
+//! ways to the group's outermost grounded pieces, widened (by rings of
+//! contacts around the pieces the solver's proof that none exists moves)
+//! up to the whole group, where the program is exact: none found there,
+//! the step fails, and the group's force program below says which pieces
+//! fall or break off. The
 //! last step is certified as the others are (the finished model's program
 //! is used there only when it is given, made already: waiting for it
 //! took 150 s on a 5,000-piece build whose steps took 45 s, and a verdict
 //! taken from whichever ended first would move with the machine's load).
 //! The finished build is solved afresh with the force program, for the
 //! usage of every piece: one answer, the same from [`analyze`] and from a
-//! step check given it, within 1e-6.
+//! step check given it, within 1e-6 (the program within capacity first,
+//! as a finished model is expected to stand). A check cut short by its
+//! deadline waits for that analysis at most [`GRACE`]; past it, its
+//! `last` is the steps checked ([`StressMap::Checked`]).
 //!
 //! Before any program is solved, the group gets a second, exact
 //! certificate: when every piece's weight can be passed down to the ground
@@ -197,7 +202,7 @@ use crate::assembly::Assembly;
 pub use pending::Pending;
 pub use steps::{
     analyze_steps, analyze_steps_from, analyze_steps_told, analyze_steps_verdicts,
-    analyze_steps_with_finished, analyze_steps_within, Finish, PROGRAM_GROWTH,
+    analyze_steps_with_finished, analyze_steps_within, Finish, GRACE, PROGRAM_GROWTH,
 };
 
 /// Default clutch capacity of one stud, in newtons (see the module docs
@@ -416,7 +421,11 @@ pub struct StepsAnalysis {
     pub first_failure: Option<u32>,
     /// The finished build's analysis (of the last step checked). Its
     /// `solve_seconds` are its programs' (the biggest of them, when the
-    /// last step's answers are carried over), not the whole check's.
+    /// last step's answers are carried over), not the whole check's. A
+    /// check cut short by its deadline has the finished model's if it was
+    /// made by then, else only the steps checked (fewer pieces than the
+    /// build; `map` is [`StressMap::Checked`]): nothing past the deadline
+    /// is waited for.
     pub last: Analysis,
     /// Wall-clock seconds for everything.
     pub seconds: f64,
@@ -460,6 +469,10 @@ pub enum StressMap {
     /// that failed: within every capacity where the structure stands, but
     /// one of many.
     Certificates,
+    /// The steps checked, as [`StressMap::Certificates`]: the check was
+    /// cut short by its deadline before the finished model was analysed,
+    /// so `last` holds only the pieces of the steps checked.
+    Checked,
 }
 
 impl StepsAnalysis {

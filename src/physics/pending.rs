@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use crate::assembly::Assembly;
 
-use super::{model::Structure, steps, Analysis, Params, PhysicsError};
+use super::model::{Progress, Structure};
+use super::{steps, Analysis, Params, PhysicsError};
 
 /// The answer's slot, and the signal that it is filled.
 type Slot = (Mutex<Option<Result<Analysis, PhysicsError>>>, Condvar);
@@ -38,21 +39,30 @@ struct Inner {
     pieces: usize,
     since: Instant,
     stop: Arc<AtomicBool>,
+    progress: Arc<Progress>,
     answer: Arc<Slot>,
 }
+
+/// The interior-point iterations a program of a finished model is taken
+/// to need, at least, when judging whether it can end in time (the
+/// bunny's and suzanne's at 48-72 studs took 55-83; one whose model needs
+/// a hand, 192).
+const ITERATIONS: u32 = 60;
 
 impl Pending {
     /// Starts the analysis of `assembly` (a copy of it is taken).
     pub fn start(assembly: &Assembly, params: &Params) -> Pending {
         let stop = Arc::new(AtomicBool::new(false));
+        let progress = Arc::new(Progress::default());
         let answer: Arc<Slot> = Arc::new((Mutex::new(None), Condvar::new()));
         let (asm, params) = (assembly.clone(), *params);
         let (flag, slot) = (Arc::clone(&stop), Arc::clone(&answer));
+        let told = Arc::clone(&progress);
         let spawned = std::thread::Builder::new()
             .name("finished model".into())
             .spawn(move || {
                 let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    analyze_stopping(&asm, &params, flag)
+                    analyze_stopping(&asm, &params, flag, told)
                 }))
                 .unwrap_or_else(|_| {
                     Err(PhysicsError::Bug(
@@ -69,8 +79,26 @@ impl Pending {
             pieces: assembly.pieces.len(),
             since: Instant::now(),
             stop,
+            progress,
             answer,
         }))
+    }
+
+    /// Whether it may still end by `deadline`: made, or not far enough
+    /// along to tell, or its program's iterations so far, at the pace of
+    /// every iteration since it started, leave time for the rest of at
+    /// least [`ITERATIONS`] (and a few more). False when it cannot: its
+    /// answer is then not worth waiting for.
+    pub fn may_end_by(&self, deadline: Instant) -> bool {
+        use std::sync::atomic::Ordering::Relaxed;
+        let total = self.0.progress.total.load(Relaxed);
+        let current = self.0.progress.current.load(Relaxed);
+        if total < 5 || self.stands().is_some() {
+            return true;
+        }
+        let pace = self.0.since.elapsed().as_secs_f64() / f64::from(total);
+        let left = f64::from(ITERATIONS.saturating_sub(current).max(5)) * pace;
+        Instant::now() + std::time::Duration::from_secs_f64(left.min(1e9)) < deadline
     }
 
     /// The pieces of the assembly analysed.
@@ -142,6 +170,7 @@ fn analyze_stopping(
     assembly: &Assembly,
     params: &Params,
     stop: Arc<AtomicBool>,
+    progress: Arc<Progress>,
 ) -> Result<Analysis, PhysicsError> {
     let start = Instant::now();
     params.check()?;
@@ -151,6 +180,7 @@ fn analyze_stopping(
         .map_err(|e| PhysicsError::Bug(format!("a thread for the finished model: {e}")))?;
     let mut s = Structure::new(assembly, params);
     s.stop = Some(stop);
+    s.progress = Some(progress);
     let pieces = pool.install(|| steps::solve_all(&s, assembly.pieces.len(), params))?;
     Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
 }
@@ -192,7 +222,7 @@ mod tests {
         let stop = Arc::new(AtomicBool::new(true));
         // Stopped before it starts: the solver gives up at its first
         // iteration, and says so.
-        let r = analyze_stopping(&overhang(), &Params::default(), stop);
+        let r = analyze_stopping(&overhang(), &Params::default(), stop, Default::default());
         assert!(matches!(r, Err(PhysicsError::Solver { .. })), "{r:?}");
         let p = Pending::start(&overhang(), &Params::default());
         let flag = Arc::clone(&p.0.stop);

@@ -13,7 +13,7 @@ use crate::assembly::Assembly;
 use super::certify::{Certifier, Verdict};
 use super::compression;
 use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
-use super::model::{solve, Contact, Structure};
+use super::model::{solve, Contact, First, Structure};
 use super::{
     weakest, Analysis, Params, Pending, PhysicsError, PieceStress, StepCheck, StepsAnalysis,
     StressMap,
@@ -38,6 +38,13 @@ type Answer = (Vec<PieceStress>, Found, f64);
 /// each a sparse factorization: measured on bunny builds of 623 to 3,625
 /// pieces).
 pub const PROGRAM_GROWTH: f64 = 2.3;
+
+/// How long past its deadline a check cut short waits for the finished
+/// model's analysis (made, or made then): a small model's takes a few
+/// milliseconds and is always had; a big one's (the bunny at 72 studs
+/// with its columns: 152 s) is not waited for, and the check says the
+/// finished model was not analysed ([`StressMap::Checked`]).
+pub const GRACE: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// The time to keep, before a deadline, for the analysis of the finished
 /// model that a check cut short leaves to make (by the deadline less that
@@ -92,7 +99,12 @@ fn past(deadline: Option<Instant>) -> bool {
 
 /// Solves the jobs in parallel, in order: each job's stress per piece,
 /// how it was found and the seconds its solve took.
-fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>, PhysicsError> {
+fn run_refs(
+    s: &Structure,
+    jobs: &[&Job],
+    params: &Params,
+    first: First,
+) -> Result<Vec<Answer>, PhysicsError> {
     jobs.par_iter()
         .map(|job| {
             if !job.grounded {
@@ -111,7 +123,7 @@ fn run_refs(s: &Structure, jobs: &[&Job], params: &Params) -> Result<Vec<Answer>
             }
             let contacts: Vec<&Contact> = job.contacts.iter().map(|&k| &s.contacts[k]).collect();
             let start = Instant::now();
-            solve(s, &job.pieces, &contacts, params)
+            solve(s, &job.pieces, &contacts, params, first)
                 .map(|r| (r.stress, Found::Solved, start.elapsed().as_secs_f64()))
         })
         .collect()
@@ -151,7 +163,8 @@ fn solve_all_but(
             _ => todo.push(job),
         }
     }
-    let results = run_refs(s, &todo, params)?;
+    // The finished build: expected to stand.
+    let results = run_refs(s, &todo, params, First::Within)?;
     for (job, (r, _, _)) in todo.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
@@ -189,9 +202,10 @@ pub fn analyze_steps(
 
 /// [`analyze_steps`] with a deadline: once it has passed, no further step
 /// is checked ([`StepsAnalysis::complete`] is false and `steps` ends at the
-/// last step checked), but the finished build is still analysed whole;
-/// when it fails and no checked step did, `first_failure` is the last
-/// step. That analysis starts, alongside the steps, at the deadline less
+/// last step checked), but the finished build is still analysed whole,
+/// if that is done within [`GRACE`] of the deadline (else `last` is the
+/// steps checked, [`StressMap::Checked`]); when it fails and no checked
+/// step did, `first_failure` is the last step. That analysis starts, alongside the steps, at the deadline less
 /// the time it is expected to take (from the biggest program solved, once
 /// one has a quarter of the pieces), so that it ends near the deadline
 /// while the steps go on up to it with the cores it leaves: it is then
@@ -515,6 +529,66 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
         self.wait()
     }
 
+    /// The analysis if made by `until` (or given): made here when not
+    /// started; one made here and not done by then is stopped (its solver
+    /// at its next iteration), one made outside the check is left to its
+    /// owner. Once `until` has passed, one made here is neither made nor
+    /// looked at.
+    fn made_by(&mut self, until: Instant) -> Result<Option<&Finished>, PhysicsError> {
+        let stop = || {
+            if let Some(flag) = &self.s.stop {
+                flag.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        };
+        let late = Instant::now() >= until;
+        match &self.state {
+            // Too late to make it or wait for it.
+            State::Due if late => {}
+            State::Running { .. } if late => stop(),
+            State::Due => {
+                // Solved here, a watchdog stopping it at `until`.
+                let (done, watch) = std::sync::mpsc::channel::<()>();
+                let flag = self.s.stop.clone();
+                let watchdog = std::thread::spawn(move || {
+                    let left = until.saturating_duration_since(Instant::now());
+                    if watch.recv_timeout(left).is_err() {
+                        if let Some(flag) = flag {
+                            flag.store(true, std::sync::atomic::Ordering::Relaxed);
+                        }
+                    }
+                });
+                let begun = Instant::now();
+                let r = solve_all(self.s, self.n, self.params);
+                let _ = done.send(());
+                let _ = watchdog.join();
+                self.made = true;
+                match r {
+                    Ok(whole) => self.state = State::Done((whole, begun.elapsed().as_secs_f64())),
+                    Err(PhysicsError::Solver { .. }) if Instant::now() >= until => {}
+                    Err(e) => return Err(e),
+                }
+            }
+            State::Pending(p) => {
+                if let Some(a) = p.wait_until(Some(until)).transpose()? {
+                    self.state = State::Done((a.pieces, a.solve_seconds));
+                }
+            }
+            State::Running { answer, .. } => {
+                let left = until.saturating_duration_since(Instant::now());
+                match answer.recv_timeout(left) {
+                    Ok(r) => self.state = State::Done(r?),
+                    Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Err(lost()),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => stop(),
+                }
+            }
+            State::Done(_) => {}
+        }
+        Ok(match &self.state {
+            State::Done(f) => Some(f),
+            _ => None,
+        })
+    }
+
     /// Waits for the analysis if it runs: its answer, once made.
     fn wait(&mut self) -> Result<Option<&Finished>, PhysicsError> {
         if let State::Pending(p) = self.state {
@@ -555,7 +629,10 @@ fn lost() -> PhysicsError {
 fn check_steps(ask: &Ask, finish: Finish) -> Result<StepsAnalysis, PhysicsError> {
     let start = Instant::now();
     ask.params.check()?;
-    let s = Structure::new(ask.assembly, ask.params);
+    let mut s = Structure::new(ask.assembly, ask.params);
+    // Set once a check cut short by its deadline gives up the finished
+    // model's programs still running (the steps' own are done by then).
+    s.stop = Some(Default::default());
     rayon::in_place_scope(|scope| {
         let mut fin = Finisher::new(scope, &s, ask.params, ask.assembly.pieces.len(), finish);
         check_steps_in(ask, &s, start, &mut fin)
@@ -721,7 +798,8 @@ fn check_steps_in(
             complete = false;
             break;
         }
-        let results = run_refs(s, &late, params)?;
+        // No certificate found: expected to fail.
+        let results = run_refs(s, &late, params, First::Least)?;
         solves += results.iter().filter(|r| r.1 == Found::Solved).count();
         certified += results.iter().filter(|r| r.1 == Found::Certified).count();
         for (job, (r, found, secs)) in late.iter().zip(results) {
@@ -747,11 +825,11 @@ fn check_steps_in(
     // the finished build.
     let end = if complete { begin } else { n };
     // One being made outside the check is waited for only when the check
-    // needs the finished model: at its last step, or when cut short.
-    let finished = if complete {
-        fin.answer()?.cloned()
-    } else {
-        fin.wait()?.cloned()
+    // needs the finished model at its last step; a check cut short by its
+    // deadline takes it if made within [`GRACE`] of it.
+    let finished = match (complete, deadline) {
+        (false, Some(d)) => fin.made_by(d + GRACE)?.cloned(),
+        _ => fin.answer()?.cloned(),
     };
     solves += usize::from(fin.made);
     // A complete check has found the last step's groups already, most of
@@ -764,6 +842,9 @@ fn check_steps_in(
             step_seconds,
             StressMap::Certificates,
         ),
+        // Cut short, the finished model not analysed by the deadline: the
+        // steps checked, as their certificates and programs left them.
+        _ if !complete => (current[..begin].to_vec(), step_seconds, StressMap::Checked),
         _ => {
             let known = complete.then_some((&current[..end], &exact[..end]));
             let begun = Instant::now();

@@ -254,7 +254,8 @@ pub fn booklet(p: &Pictures<'_>, r: &Rendered, template: &Template) -> std::io::
 /// The finished model with each piece coloured by the share of its clutch
 /// capacity used: green none, yellow half, red all (or falls). It is seen
 /// from the quarter turn of the default view that shows the most of the
-/// weakest pieces (see [`stress_turns`]).
+/// weakest pieces (see [`stress_turns`]). Pieces past the analysis (of
+/// the steps a check cut short by its budget reached) are grey.
 pub fn stress_image(
     assembly: &Assembly,
     analysis: &crate::physics::Analysis,
@@ -263,6 +264,8 @@ pub fn stress_image(
         .pieces
         .iter()
         .map(|p| render::stress_color(if p.falls { f64::INFINITY } else { p.usage }))
+        .chain(std::iter::repeat(render::stress_color(f64::NAN)))
+        .take(assembly.pieces.len())
         .collect();
     let view = render::View::default().turned(stress_turns(assembly, analysis)?);
     let mut img = render::model_image_with_colors(assembly, &colors, &options().with_view(view))?;
@@ -306,6 +309,8 @@ fn weak_pixels(
         .pieces
         .iter()
         .map(|p| p.fails() || (top >= WEAK_MIN && p.usage >= WEAK_SHARE * top))
+        .chain(std::iter::repeat(false))
+        .take(assembly.pieces.len())
         .collect();
     if !weak.contains(&true) {
         return Ok(None);

@@ -30,9 +30,13 @@ use crate::physics::repair::{reorder_while, Moved, MAX_REPAIRED_STEP};
 use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
 use crate::physics::{
     analyze, analyze_steps_verdicts, Analysis, Finish, Ground, Params, Pending, PhysicsError,
-    StepsAnalysis, StressMap,
+    StepsAnalysis, StressMap, GRACE,
 };
 use crate::search::SearchOutcome;
+
+/// How often the wait for the finished model's map looks at how far its
+/// program is (see [`Pending::may_end_by`]).
+const LOOK: Duration = Duration::from_millis(250);
 
 /// What the stability stage does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -546,6 +550,27 @@ impl Attempt {
         Ok(a.partial_cmp(&b) == Some(std::cmp::Ordering::Greater))
     }
 
+    /// The finished model's analysis if made by `until` (being made, or
+    /// started now if it is not).
+    fn finished_by(
+        &mut self,
+        params: &Params,
+        until: Instant,
+        counts: &mut Counts,
+    ) -> Result<Option<&Analysis>, crate::pipeline::BuildError> {
+        if self.finished.is_none() {
+            let pending = self
+                .pending
+                .get_or_insert_with(|| Pending::start(&self.plan.1, params));
+            if let Some(made) = pending.wait_until(Some(until)) {
+                counts.solves += 1;
+                self.finished = Some(made?);
+                self.pending = None;
+            }
+        }
+        Ok(self.finished.as_ref())
+    }
+
     /// The finished model's analysis, made if not yet.
     fn finished(
         &mut self,
@@ -736,7 +761,8 @@ fn stopped_early(asm: &Assembly, check: &StepsAnalysis) -> bool {
 
 /// Completes a check that stopped at its first failure: the steps after
 /// it, and the finished model as its `last`; past the deadline, only the
-/// finished model's analysis takes `last`'s place.
+/// finished model's analysis takes `last`'s place, if made within
+/// [`GRACE`] of it (else `last` stays the failing structure).
 fn check_the_rest(
     best: &mut Attempt,
     params: &Params,
@@ -773,8 +799,14 @@ fn check_the_rest(
             return Ok(());
         }
     }
-    best.check.last = best.finished(params, counts)?.clone();
-    best.check.map = StressMap::Program;
+    // Past the deadline: the finished model's analysis if made within
+    // the grace, else the failing structure stays the check's last.
+    if let Some(f) = best.finished_by(params, deadline + GRACE, counts)? {
+        best.check.last = f.clone();
+        best.check.map = StressMap::Program;
+    } else {
+        best.check.map = StressMap::Checked;
+    }
     best.check.complete = false;
     best.partial = false;
     Ok(())
@@ -807,9 +839,16 @@ fn map_finished(
             let job = pending
                 .take()
                 .unwrap_or_else(|| Pending::start(assembly, params));
-            // Not made by the deadline: dropped, it stops.
-            let Some(made) = job.wait_until(Some(deadline)) else {
-                return Ok(StressMap::Certificates);
+            // Not made by the deadline, or seen not to end by then (at
+            // the pace of its iterations so far): dropped, it stops.
+            let made = loop {
+                let soon = deadline.min(Instant::now() + LOOK);
+                if let Some(made) = job.wait_until(Some(soon)) {
+                    break made;
+                }
+                if Instant::now() >= deadline || !job.may_end_by(deadline) {
+                    return Ok(StressMap::Certificates);
+                }
             };
             counts.solves += 1;
             finished.insert(made?)
