@@ -686,7 +686,13 @@ fn attempt(
                 )?;
                 counts.add(&c);
                 if c.complete && later(c.first_failure, at.check.first_failure) {
-                    if at.finished(params, counts)?.stands() {
+                    // Kept only if the finished model stands: known within
+                    // the grace after the deadline, or not kept.
+                    let until = deadline + GRACE;
+                    if at
+                        .finished_by(params, until, counts)?
+                        .is_some_and(Analysis::stands)
+                    {
                         order_kept(&mut at, r, c)?;
                     } else {
                         at.order_tried = None;
