@@ -87,7 +87,7 @@ impl Pending {
     /// Whether it may still end by `deadline`: made, or not far enough
     /// along to tell, or its program's iterations so far, at the pace of
     /// every iteration since it started, leave time for the rest of at
-    /// least [`ITERATIONS`] (and a few more). False when it cannot: its
+    /// least `ITERATIONS`, 60 (and a few more). False when it cannot: its
     /// answer is then not worth waiting for.
     pub fn may_end_by(&self, deadline: Instant) -> bool {
         use std::sync::atomic::Ordering::Relaxed;

@@ -71,7 +71,7 @@ pub const MAX_REPAIRED_STEP: usize = 3 * crate::assembly::STEP_PIECES;
 /// with it costs an analysis each step (the bunny at 72 studs: nothing
 /// from step 32 on stood, and 245 pieces waited by step 64, half a minute
 /// in, before the walk ran out of time).
-const MAX_WAITING: usize = MAX_REPAIRED_STEP;
+pub const MAX_WAITING: usize = MAX_REPAIRED_STEP;
 
 /// Re-sequences `assembly`, whose steps before `first_failure` stand, so
 /// that the pieces which break off or fall are added only once the
