@@ -753,9 +753,16 @@ impl<'a> Layout<'a> {
         let up = spec.shape == Shape::Slope;
         let dz = if up { 1 } else { -1 };
         let blocked = |n: Cell| self.must.in_bounds(n) && (self.must.get(n) || !self.free(n));
+        // On top, the whole course over the face: the model starting half
+        // a course up there takes a piece in that course all the same, and
+        // it would stand on the face (the engine at 48 studs left 5 voxels
+        // out so: no piece could go under them).
+        let reach = if up { self.phase.max(1) } else { 1 };
         if open().any(|q| {
-            let n = q.offset(0, 0, dz);
-            !b.bbox.contains(n) && blocked(n)
+            (1..=reach).any(|k| {
+                let n = q.offset(0, 0, dz * k);
+                !b.bbox.contains(n) && blocked(n)
+            })
         }) {
             return false;
         }
