@@ -283,3 +283,99 @@ fn bricks_a_piece(a: &Assembly, per_brick: i32) -> f64 {
         .sum();
     f64::from(cells) / f64::from(per_brick) / a.pieces.len() as f64
 }
+
+/// Two gable roofs stacked a `gap` apart (the upper one a slab `thick`
+/// deep, its underside parallel to the lower one's top, `slope` the rise
+/// per unit across), joined by a pillar at the ridge, as OBJ text (y up):
+/// where the slab's underside starts half a course over the lower roof's
+/// slopes, the model goes on over a slope's face within a course.
+fn chevrons(slope: f64, gap: f64) -> String {
+    let (w, depth, thick, base) = (10.0, 8.0, 1.5, 2.0);
+    let ridge = base + w * slope;
+    let lower = [(-w, 0.0), (w, 0.0), (w, base), (0.0, ridge), (-w, base)];
+    let upper = [
+        (-w, base + gap),
+        (0.0, ridge + gap),
+        (w, base + gap),
+        (w, base + gap + thick),
+        (0.0, ridge + gap + thick),
+        (-w, base + gap + thick),
+    ];
+    let mut v: Vec<(f64, f64, f64)> = Vec::new();
+    let mut f: Vec<(usize, usize, usize)> = Vec::new();
+    // A profile in x-z, made solid along y from 0 to `depth`: both ends
+    // fanned from the profile's centre, the sides in quads.
+    let mut extrude = |poly: &[(f64, f64)]| {
+        let (n, o) = (poly.len(), v.len());
+        for y in [0.0, depth] {
+            v.extend(poly.iter().map(|&(x, z)| (x, y, z)));
+        }
+        let cx = poly.iter().map(|p| p.0).sum::<f64>() / n as f64;
+        let cz = poly.iter().map(|p| p.1).sum::<f64>() / n as f64;
+        let (c0, c1) = (v.len(), v.len() + 1);
+        v.push((cx, 0.0, cz));
+        v.push((cx, depth, cz));
+        for i in 0..n {
+            let j = (i + 1) % n;
+            f.push((c0, o + j, o + i));
+            f.push((c1, o + n + i, o + n + j));
+            f.push((o + i, o + j, o + n + j));
+            f.push((o + i, o + n + j, o + n + i));
+        }
+    };
+    extrude(&lower);
+    extrude(&upper);
+    // The pillar: a box through the ridge into the slab.
+    let (x0, x1, y0, y1, z0, z1) = (
+        -1.0,
+        1.0,
+        depth / 2.0 - 1.0,
+        depth / 2.0 + 1.0,
+        ridge - 0.5,
+        ridge + gap + 0.5,
+    );
+    let o = v.len();
+    for z in [z0, z1] {
+        v.extend([(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)]);
+    }
+    for (a, b, c, d) in [
+        (0, 3, 2, 1),
+        (4, 5, 6, 7),
+        (0, 1, 5, 4),
+        (1, 2, 6, 5),
+        (2, 3, 7, 6),
+        (3, 0, 4, 7),
+    ] {
+        f.push((o + a, o + b, o + c));
+        f.push((o + a, o + c, o + d));
+    }
+    let mut obj = String::from("o chevrons\n");
+    for (x, y, z) in v {
+        obj += &format!("v {x:.5} {z:.5} {y:.5}\n");
+    }
+    for (a, b, c) in f {
+        obj += &format!("f {} {} {}\n", a + 1, b + 1, c + 1);
+    }
+    obj
+}
+
+#[test]
+fn nothing_is_left_out_over_a_slope_within_a_course() {
+    // A slope's face with the model half a course over it: a piece in
+    // that course would stand on the face, joined to nothing, so the
+    // face must be clear for the whole course (`build` checks every voxel
+    // is built and the build verifies).
+    let dir = tempfile::tempdir().unwrap();
+    for (k, (slope, gap)) in [(1.0, 0.7), (1.0, 1.0), (0.6, 1.0)].into_iter().enumerate() {
+        let path = dir.path().join(format!("chevrons{k}.obj"));
+        std::fs::write(&path, chevrons(slope, gap)).unwrap();
+        for studs in [16, 20, 24, 28] {
+            let sloped = build(&path, studs, true);
+            assert!(
+                slopes(&sloped) > 0,
+                "{}: no slope at {studs} studs",
+                path.display()
+            );
+        }
+    }
+}
