@@ -405,9 +405,16 @@ fn spread(cols: usize, joints: &[(usize, Option<usize>, usize)], spread: f64) ->
 /// under a stud's capacity (a usage of 1 breaks the joint).
 pub(super) const CAP: f64 = 1.0 - 1e-6;
 
+/// Whether `s`'s programs were told to stop (see [`Structure::stop`]).
+fn stopped(s: &Structure) -> bool {
+    s.stop
+        .as_ref()
+        .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+}
+
 /// Which of [`solve`]'s two programs is solved first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum First {
+pub(crate) enum First {
     /// Within capacity, no hand: for a group expected to stand (a
     /// finished model), which it settles in one program.
     Within,
@@ -456,6 +463,8 @@ pub(super) fn solve(
         };
         match solve_by(s, pieces, contacts, params, Some(&held), bare) {
             Ok(held) if !held.stress.iter().any(PieceStress::fails) => Ok(Some(held)),
+            // Stopped (its answer no longer wanted): so would the other.
+            Err(e @ PhysicsError::Solver { .. }) if stopped(s) => Err(e),
             // No answer within capacity (or the solver's trouble): the
             // other program says.
             Ok(_) | Err(PhysicsError::Solver { .. }) => Ok(None),

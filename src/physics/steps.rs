@@ -129,13 +129,24 @@ fn run_refs(
         .collect()
 }
 
-/// Every piece of the first `n` pieces, all groups solved (in parallel).
+/// Every piece of the first `n` pieces, all groups solved (in parallel),
+/// each expected to stand ([`First::Within`]).
 pub(super) fn solve_all(
     s: &Structure,
     n: usize,
     params: &Params,
 ) -> Result<Vec<PieceStress>, PhysicsError> {
-    solve_all_but(s, n, params, None).map(|(out, _)| out)
+    solve_all_first(s, n, params, First::Within)
+}
+
+/// [`solve_all`], each group's programs in the order `first`.
+pub(super) fn solve_all_first(
+    s: &Structure,
+    n: usize,
+    params: &Params,
+    first: First,
+) -> Result<Vec<PieceStress>, PhysicsError> {
+    solve_all_but(s, n, params, None, first).map(|(out, _)| out)
 }
 
 /// [`solve_all`], taking from `known` (stress, and whether it is exact)
@@ -147,6 +158,7 @@ fn solve_all_but(
     n: usize,
     params: &Params,
     known: Option<(&[PieceStress], &[bool])>,
+    first: First,
 ) -> Result<(Vec<PieceStress>, bool), PhysicsError> {
     let mut g = Groups::new();
     let (mut next, mut reused) = (0, 0);
@@ -163,8 +175,7 @@ fn solve_all_but(
             _ => todo.push(job),
         }
     }
-    // The finished build: expected to stand.
-    let results = run_refs(s, &todo, params, First::Within)?;
+    let results = run_refs(s, &todo, params, first)?;
     for (job, (r, _, _)) in todo.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
@@ -535,8 +546,8 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
     /// owner. Once `until` has passed, one made here is neither made nor
     /// looked at.
     fn made_by(&mut self, until: Instant) -> Result<Option<&Finished>, PhysicsError> {
-        let stop = || {
-            if let Some(flag) = &self.s.stop {
+        let stop = |flag: &Option<std::sync::Arc<std::sync::atomic::AtomicBool>>| {
+            if let Some(flag) = flag {
                 flag.store(true, std::sync::atomic::Ordering::Relaxed);
             }
         };
@@ -544,7 +555,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
         match &self.state {
             // Too late to make it or wait for it.
             State::Due if late => {}
-            State::Running { .. } if late => stop(),
+            State::Running { .. } if late => stop(&self.s.stop),
             State::Due => {
                 // Solved here, a watchdog stopping it at `until`.
                 let (done, watch) = std::sync::mpsc::channel::<()>();
@@ -552,9 +563,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
                 let watchdog = std::thread::spawn(move || {
                     let left = until.saturating_duration_since(Instant::now());
                     if watch.recv_timeout(left).is_err() {
-                        if let Some(flag) = flag {
-                            flag.store(true, std::sync::atomic::Ordering::Relaxed);
-                        }
+                        stop(&flag);
                     }
                 });
                 let begun = Instant::now();
@@ -578,7 +587,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
                 match answer.recv_timeout(left) {
                     Ok(r) => self.state = State::Done(r?),
                     Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Err(lost()),
-                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => stop(),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => stop(&self.s.stop),
                 }
             }
             State::Done(_) => {}
@@ -848,7 +857,7 @@ fn check_steps_in(
         _ => {
             let known = complete.then_some((&current[..end], &exact[..end]));
             let begun = Instant::now();
-            let (last, ran) = solve_all_but(s, end, params, known)?;
+            let (last, ran) = solve_all_but(s, end, params, known, First::Within)?;
             solves += usize::from(ran);
             // What the finished build's programs take: as solved now, or
             // as the last step checked solved them.

@@ -492,23 +492,8 @@ impl Attempt {
         deadline: Instant,
         counts: &mut Counts,
     ) -> Result<Option<Duration>, crate::pipeline::BuildError> {
-        if self.finished.is_none() {
-            let pending = self
-                .pending
-                .take()
-                .unwrap_or_else(|| Pending::start(&self.plan.1, params));
-            match pending.wait_until(Some(deadline)) {
-                Some(made) => {
-                    counts.solves += 1;
-                    self.finished = Some(made?);
-                }
-                None => {
-                    self.pending = Some(pending);
-                    return Ok(None);
-                }
-            }
-        }
-        Ok(Some(self.analysis_time()))
+        let made = self.finished_by(params, deadline, counts)?.is_some();
+        Ok(made.then(|| self.analysis_time()))
     }
 
     /// The finished model's analysis for a step check: known, or being
