@@ -185,6 +185,151 @@ fn a_hollow_skyscraper_keeps_every_tier() {
     verified_with_stability(&tmp.path().join("skyscraper.ldr"));
 }
 
+/// A body `w` wide, `d` deep and `h` high on a pedestal under its middle,
+/// `pw` wide (across x), one layer high and as deep as the body: the
+/// profile of an upside-down T extruded along z, as OBJ text (y up).
+fn on_a_pedestal(w: f64, d: f64, h: f64, pw: f64) -> String {
+    let (a, b, h0) = ((w - pw) / 2.0, (w + pw) / 2.0, 1.2);
+    let profile = [
+        (a, 0.0),
+        (b, 0.0),
+        (b, h0),
+        (w, h0),
+        (w, h),
+        (0.0, h),
+        (0.0, h0),
+        (a, h0),
+    ];
+    let n = profile.len();
+    let mut obj = String::from("o pedestal\n");
+    for z in [0.0, d] {
+        for (x, y) in profile {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    // Each end: the pedestal's rectangle and the body's hexagon (a fan).
+    let caps = [
+        (0, 2, 1),
+        (0, 7, 2),
+        (5, 7, 6),
+        (5, 2, 7),
+        (5, 3, 2),
+        (5, 4, 3),
+    ];
+    let mut f: Vec<(usize, usize, usize)> = Vec::new();
+    for (i, j, k) in caps {
+        f.push((i, j, k));
+        f.push((i + n, k + n, j + n));
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        f.push((i, j + n, j));
+        f.push((i, i + n, j + n));
+    }
+    for (i, j, k) in f {
+        obj += &format!("f {} {} {}\n", i + 1, j + 1, k + 1);
+    }
+    obj
+}
+
+/// A box `w` square and `h` high on a square pedestal `pw` wide under its
+/// middle, one layer high, as OBJ text (y up).
+fn on_a_square_pedestal(w: f64, h: f64, pw: f64) -> String {
+    let (a, b, h0) = ((w - pw) / 2.0, (w + pw) / 2.0, 1.2);
+    let v = [
+        (0.0, h0, 0.0),
+        (w, h0, 0.0),
+        (w, h0, w),
+        (0.0, h0, w),
+        (0.0, h, 0.0),
+        (w, h, 0.0),
+        (w, h, w),
+        (0.0, h, w),
+        (a, h0, a),
+        (b, h0, a),
+        (b, h0, b),
+        (a, h0, b),
+        (a, 0.0, a),
+        (b, 0.0, a),
+        (b, 0.0, b),
+        (a, 0.0, b),
+    ];
+    // The top, the sides, the body's underside round the pedestal, the
+    // pedestal's sides and bottom.
+    let quads = [
+        [4, 7, 6, 5],
+        [0, 1, 5, 4],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 0, 4, 7],
+        [0, 8, 9, 1],
+        [1, 9, 10, 2],
+        [2, 10, 11, 3],
+        [3, 11, 8, 0],
+        [8, 12, 13, 9],
+        [9, 13, 14, 10],
+        [10, 14, 15, 11],
+        [11, 15, 12, 8],
+        [12, 15, 14, 13],
+    ];
+    let mut obj = String::from("o pedestal\n");
+    for (x, y, z) in v {
+        obj += &format!("v {x} {y} {z}\n");
+    }
+    for [i, j, k, l] in quads {
+        obj += &format!(
+            "f {} {} {}\nf {} {} {}\n",
+            i + 1,
+            j + 1,
+            k + 1,
+            i + 1,
+            k + 1,
+            l + 1
+        );
+    }
+    obj
+}
+
+/// Bodies on pedestals narrower than themselves, hollow. Where the
+/// pedestal's one layer keeps a pocket too narrow to empty under the
+/// hollow emptied over it, that floor joined nothing, and its voxels were
+/// left out (a body on a pedestal as deep as itself at 22-26 studs: 24-28
+/// voxels; on a square pedestal at 20-26 studs: 24-64). The floor is now
+/// emptied where the model stands on the table beside it (the long
+/// pedestal's ends, under the end walls), or made as thick as a lid where
+/// it is all that stands there (the square pedestal): every voxel of the
+/// shell is built. (At 28-30 studs the square pedestal is two layers high,
+/// a rim round a hollow of its own under the body's hollow, and is left
+/// out as before: a floor as thick as a lid is not mended.)
+#[test]
+fn no_floor_thinner_than_a_lid_is_left_under_the_hollow() {
+    let tmp = tempfile::tempdir().unwrap();
+    let long = tmp.path().join("long.obj");
+    std::fs::write(&long, on_a_pedestal(20.0, 20.0, 8.0, 7.0)).unwrap();
+    let square = tmp.path().join("square.obj");
+    std::fs::write(&square, on_a_square_pedestal(20.0, 8.0, 7.0)).unwrap();
+    for (path, studs) in [(&long, 22), (&long, 24), (&long, 26)]
+        .into_iter()
+        .chain([20, 22, 24, 26].map(|s| (&square, s)))
+    {
+        let mut opts = BuildOptions::new(path.clone());
+        opts.out_dir = tmp.path().join(format!("out{studs}"));
+        opts.sizing = Sizing::Studs(studs);
+        opts.formats = Formats::parse("ldr").unwrap();
+        opts.stability = Stability::Off;
+        opts.search = opts.search.clone().with_hollow(Wall::new(2));
+        let out = pipeline::build(&opts, &Silent).unwrap();
+        let at = format!("{} at {studs} studs", path.display());
+        assert_eq!(
+            out.report.quality.left_out, 0,
+            "{at}: {:?}",
+            out.report.quality
+        );
+        let h = out.report.hollow.as_ref().unwrap();
+        assert!(h.emptied_voxels > 0, "{at}: {h:?}");
+    }
+}
+
 #[test]
 fn at_44_studs_inner_pillars_hold_the_house_roof_and_go_in_before_it_closes() {
     let tmp = tempfile::tempdir().unwrap();

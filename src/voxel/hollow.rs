@@ -15,6 +15,10 @@
 //!   floor, and the shell is closed all the same).
 //! - A lid over the hollow is at least as thick as the thinnest sheet that
 //!   holds together (two courses of bricks side by side do, one does not).
+//! - No floor thinner than a lid is left on the table under the hollow
+//!   (where the lowest layer of a foot keeps a pocket too narrow to empty):
+//!   it is emptied too, unless it is all that stands there (a pedestal),
+//!   which is made as thick as a lid instead.
 //! - Pockets narrower than [`MIN_HOLE`] studs are filled again: a slot
 //!   under a ridge costs more pieces, short ones bridging it, than it
 //!   saves.
@@ -107,8 +111,86 @@ pub fn hollow(solid: &VoxelGrid, wall: Wall, course: i32, min_lid: i32) -> Hollo
     for c in emptied.cells() {
         shell.set(c, false);
     }
+    no_thin_floor(&mut shell, &mut emptied, min_lid);
     lid_under_hanging(&mut shell, &mut emptied, up);
     Hollowed { shell, emptied }
+}
+
+/// Mends the shell standing on the table under the hollow where it is
+/// thinner than `min_lid` layers (a floor that does not hold together): a
+/// pocket too narrow to empty in a low layer (a foot rounded at the bottom
+/// is narrower there than above) left a floor a course thick under the
+/// hollow, whose pieces could join nothing above them (the hollow) nor
+/// below (the table), and the layout left them out (the bunny at 72 studs,
+/// `--hollow`: 8 voxels). A stretch of such floor beside shell that goes on
+/// up (the foot's wall) is emptied: the table is the floor there, as
+/// everywhere under the hollow. A stretch with none beside it is all that
+/// stands there (a pedestal under a wider body): it is thickened instead,
+/// the hollow over it filled again to a lid's thickness, so that its upper
+/// layer lies beside the shell around it.
+fn no_thin_floor(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, min_lid: i32) {
+    let (nx, ny, nz) = shell.dims();
+    let lid = min_lid.min(nz);
+    // Per column: the floor's thickness where it is thin under the hollow.
+    let mut thin = vec![0i32; (nx * ny) as usize];
+    for y in 0..ny {
+        for x in 0..nx {
+            let floor = (0..lid)
+                .take_while(|&z| shell.get(Cell::new(x, y, z)))
+                .count() as i32;
+            if floor > 0 && floor < lid && emptied.get(Cell::new(x, y, floor)) {
+                thin[(y * nx + x) as usize] = floor;
+            }
+        }
+    }
+    let mut seen = vec![false; thin.len()];
+    for start in 0..thin.len() {
+        if thin[start] == 0 || seen[start] {
+            continue;
+        }
+        // One stretch of thin floor, side by side in the lowest layer.
+        seen[start] = true;
+        let mut stretch = vec![start];
+        let mut beside_wall = false;
+        let mut k = 0;
+        while k < stretch.len() {
+            let i = stretch[k] as i32;
+            k += 1;
+            for (dx, dy) in SIDES {
+                let (x, y) = (i % nx + dx, i / nx + dy);
+                if x < 0 || y < 0 || x >= nx || y >= ny {
+                    continue;
+                }
+                let j = (y * nx + x) as usize;
+                if thin[j] > 0 {
+                    if !seen[j] {
+                        seen[j] = true;
+                        stretch.push(j);
+                    }
+                } else if shell.get(Cell::new(x, y, 0)) {
+                    beside_wall = true;
+                }
+            }
+        }
+        for &i in &stretch {
+            let (x, y) = (i as i32 % nx, i as i32 / nx);
+            if beside_wall {
+                for z in 0..thin[i] {
+                    shell.set(Cell::new(x, y, z), false);
+                    emptied.set(Cell::new(x, y, z), true);
+                }
+            } else {
+                for z in thin[i]..lid {
+                    let c = Cell::new(x, y, z);
+                    if !emptied.get(c) {
+                        break;
+                    }
+                    emptied.set(c, false);
+                    shell.set(c, true);
+                }
+            }
+        }
+    }
 }
 
 /// The four neighbours of a cell in its layer.
