@@ -28,6 +28,10 @@
 //!   middle is hollow), gets a lid under it: the hollow it lies over is
 //!   filled again for a lid's thickness, across the whole stretch of
 //!   hollow in each of those layers, so the lid rests on the walls below.
+//! - Nothing of the shell stands under the hollow with nothing over it: a
+//!   part of a layer's shell none of whose cells has shell over it, under
+//!   the hollow (the rim of a pedestal under a wider body), gets a lid
+//!   over it, as a part hanging over the hollow gets one under it.
 //!
 //! What holds a lid or a roof over the hollow is decided later, by the
 //! stability stage, which adds inner pillars where the statics need them.
@@ -113,6 +117,7 @@ pub fn hollow(solid: &VoxelGrid, wall: Wall, course: i32, min_lid: i32) -> Hollo
     }
     no_thin_floor(&mut shell, &mut emptied, min_lid);
     lid_under_hanging(&mut shell, &mut emptied, up);
+    lid_over_standing(&mut shell, &mut emptied, up);
     Hollowed { shell, emptied }
 }
 
@@ -249,6 +254,47 @@ fn lid_under_hanging(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
                     for q in &part {
                         let below = Cell::new(q.x, q.y, z - k);
                         for h in layer_part(emptied, below) {
+                            emptied.set(h, false);
+                            shell.set(h, true);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Gives every part of a layer's shell that stands wholly under the
+/// hollow (no cell of it has shell over it, and some has hollow) a lid of
+/// `up` layers over it: in each of those layers, the stretch of hollow
+/// over its cells is filled again, whole, so that what stands there is
+/// joined to the shell around (a pedestal under a wider body, two layers
+/// high: its rim stood under the body's hollow, joined to nothing, and
+/// was left out). The mirror of [`lid_under_hanging`]; layers go from the
+/// top down.
+fn lid_over_standing(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
+    let (nx, ny, nz) = shell.dims();
+    for z in (0..nz - 1).rev() {
+        let mut looked = vec![false; (nx * ny) as usize];
+        for y in 0..ny {
+            for x in 0..nx {
+                let c = Cell::new(x, y, z);
+                if looked[(y * nx + x) as usize] || !shell.get(c) {
+                    continue;
+                }
+                let part = layer_part(shell, c);
+                for q in &part {
+                    looked[(q.y * nx + q.x) as usize] = true;
+                }
+                let held = part.iter().any(|q| shell.get(q.offset(0, 0, 1)));
+                let under_hollow = part.iter().any(|q| emptied.get(q.offset(0, 0, 1)));
+                if held || !under_hollow {
+                    continue;
+                }
+                for k in 1..=up.min(nz - 1 - z) {
+                    for q in &part {
+                        let above = Cell::new(q.x, q.y, z + k);
+                        for h in layer_part(emptied, above) {
                             emptied.set(h, false);
                             shell.set(h, true);
                         }
