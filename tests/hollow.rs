@@ -445,3 +445,26 @@ fn wall_needs_hollow_and_a_thickness_from_1_to_16() {
         assert!(!out.exists(), "{args:?}");
     }
 }
+
+/// The last resort a build takes when every layout fails verification
+/// (`SearchOptions::leave_unplaceable`: pieces no order can put in place
+/// are left out) changes nothing where every piece can be put in place.
+#[test]
+fn the_last_resort_changes_no_layout_whose_pieces_all_go_in() {
+    use brickwright::grammar::default_rules;
+    use brickwright::search::{self, Guide, SearchOptions};
+    let rules = default_rules();
+    for (name, studs) in [("house.obj", 32), ("mug.obj", 24), ("skyscraper.obj", 32)] {
+        let grid = solid(name, studs);
+        let opts = SearchOptions::default().with_hollow(Wall::new(2));
+        let plain = search::build_guided(&grid, Guide::default(), &rules, &opts).unwrap();
+        let last = opts.clone().with_leave_unplaceable(true);
+        let resort = search::build_guided(&grid, Guide::default(), &rules, &last).unwrap();
+        assert_eq!(
+            search::placements(&plain),
+            search::placements(&resort),
+            "{name}"
+        );
+        assert_eq!(resort.repairs.left_out, plain.repairs.left_out, "{name}");
+    }
+}

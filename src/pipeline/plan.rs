@@ -27,6 +27,9 @@ pub(super) struct Planner<'a> {
     verify_secs: Cell<f64>,
     /// Notes for the report's warnings.
     notes: RefCell<Vec<String>>,
+    /// The layouts being made are the last resort: they leave out what no
+    /// order can put in place ([`search::SearchOptions::leave_unplaceable`]).
+    last_resort: Cell<bool>,
 }
 
 /// Layouts made again with other seeds when one fails verification.
@@ -50,6 +53,7 @@ impl<'a> Planner<'a> {
             file: opts.input.display().to_string(),
             verify_secs: Cell::new(0.0),
             notes: RefCell::new(Vec::new()),
+            last_resort: Cell::new(false),
         }
     }
 
@@ -130,9 +134,33 @@ impl<'a> Planner<'a> {
     /// [`Self::plan`]; `told`: the layout's progress is shown. A layout
     /// that fails verification is never handed on: the layout is made
     /// again with other seeds ([`RELAYOUTS`] at most), and the notes say
-    /// so; if none verifies, the first failure is the error (a bug). No
-    /// layout is begun again once the search's time budget is spent.
+    /// so; if none verifies, the same seeds are laid out again leaving out
+    /// what no order can put in place, and if none of those verifies
+    /// either, the first failure is the error (a bug). No layout is begun
+    /// again once the search's time budget is spent.
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
+        let planned = self.plan_tries(seed, told);
+        if !matches!(planned, Err(BuildError::Unverified { .. })) {
+            return planned;
+        }
+        self.last_resort.set(true);
+        let last = self.plan_tries(seed, false);
+        self.last_resort.set(false);
+        match last {
+            Ok(p) => {
+                self.notes.borrow_mut().push(format!(
+                    "{}: no layout passed verification with every piece; the build leaves out the pieces no order could put in place",
+                    self.file
+                ));
+                Ok(p)
+            }
+            Err(BuildError::Unverified { .. }) => planned,
+            Err(e) => Err(e),
+        }
+    }
+
+    /// [`Self::plan_told`]'s layouts with `seed` and the seeds after it.
+    fn plan_tries(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
         let started = Instant::now();
         let mut first_failure = None;
         // The slopes capping the stairs are the one late change to the
@@ -197,7 +225,8 @@ impl<'a> Planner<'a> {
             .search
             .clone()
             .with_seed(seed)
-            .with_cap_stairs(cap && opts.search.cap_stairs);
+            .with_cap_stairs(cap && opts.search.cap_stairs)
+            .with_leave_unplaceable(self.last_resort.get());
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
                 file: self.file.clone(),

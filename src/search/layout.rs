@@ -256,6 +256,9 @@ pub(crate) struct Layout<'a> {
     /// Cells of `keep_empty` given back to the layout: an inner pillar
     /// under a piece that could not be put in place over the hollow.
     pub released: std::collections::HashSet<Cell>,
+    /// Cells no piece may fill: those of pieces left out because no order
+    /// could put them in place (see `search::build_guided`).
+    pub refused: std::collections::HashSet<Cell>,
     /// Per cell (by [`VoxelGrid::index`]): a surface voxel's colour label
     /// (non-zero), 0 elsewhere. A piece covers surface voxels of one label
     /// only, so colour boundaries fall between pieces.
@@ -368,6 +371,7 @@ impl<'a> Layout<'a> {
             slant,
             keep_empty: None,
             released: std::collections::HashSet::new(),
+            refused: std::collections::HashSet::new(),
             colors: None,
             any_colours: false,
             made,
@@ -395,7 +399,10 @@ impl<'a> Layout<'a> {
     }
 
     fn free(&self, c: Cell) -> bool {
-        self.must.in_bounds(c) && self.owner[self.must.index(c)] == NONE && !self.kept_empty(c)
+        self.must.in_bounds(c)
+            && self.owner[self.must.index(c)] == NONE
+            && !self.kept_empty(c)
+            && (self.refused.is_empty() || !self.refused.contains(&c))
     }
 
     /// Whether `c` must stay empty (the inside of a hollow build).
