@@ -139,12 +139,15 @@ impl<'a> Planner<'a> {
     /// either, the first failure is the error (a bug). No layout is begun
     /// again once the search's time budget is spent.
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
-        let planned = self.plan_tries(seed, told);
-        if !matches!(planned, Err(BuildError::Unverified { .. })) {
+        let started = Instant::now();
+        let planned = self.plan_tries(seed, told, started);
+        if !matches!(planned, Err(BuildError::Unverified { .. }))
+            || started.elapsed() >= self.opts.search.time_budget
+        {
             return planned;
         }
         self.last_resort.set(true);
-        let last = self.plan_tries(seed, false);
+        let last = self.plan_tries(seed, false, started);
         self.last_resort.set(false);
         match last {
             Ok(p) => {
@@ -159,9 +162,9 @@ impl<'a> Planner<'a> {
         }
     }
 
-    /// [`Self::plan_told`]'s layouts with `seed` and the seeds after it.
-    fn plan_tries(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
-        let started = Instant::now();
+    /// [`Self::plan_told`]'s layouts with `seed` and the seeds after it,
+    /// none begun once the search's time budget since `started` is spent.
+    fn plan_tries(&self, seed: u64, told: bool, started: Instant) -> Result<Plan, BuildError> {
         let mut first_failure = None;
         // The slopes capping the stairs are the one late change to the
         // layout: a build they leave unverified is laid without them too.

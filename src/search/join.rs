@@ -306,11 +306,7 @@ impl Layout<'_> {
                         let body = shape.body_at(origin);
                         if !body.bbox.intersects(&ab)
                             || !body.bbox.intersects(&b.bbox)
-                            || !body.cells().all(|q| {
-                                self.must.get(q)
-                                    && self.owner_of(q).is_none()
-                                    && !self.refused.contains(&q)
-                            })
+                            || !body.cells().all(|q| self.must.get(q) && self.free(q))
                         {
                             continue;
                         }

@@ -398,7 +398,7 @@ impl<'a> Layout<'a> {
         (o != NONE).then_some(o)
     }
 
-    fn free(&self, c: Cell) -> bool {
+    pub(super) fn free(&self, c: Cell) -> bool {
         self.must.in_bounds(c)
             && self.owner[self.must.index(c)] == NONE
             && !self.kept_empty(c)

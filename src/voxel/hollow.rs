@@ -232,49 +232,32 @@ fn layer_part(g: &VoxelGrid, start: Cell) -> Vec<Cell> {
 /// the bottom up, so a lid made is in place when the layers above it are
 /// looked at.
 fn lid_under_hanging(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
-    let (nx, ny, nz) = shell.dims();
-    for z in 1..nz {
-        let mut looked = vec![false; (nx * ny) as usize];
-        for y in 0..ny {
-            for x in 0..nx {
-                let c = Cell::new(x, y, z);
-                if looked[(y * nx + x) as usize] || !shell.get(c) {
-                    continue;
-                }
-                let part = layer_part(shell, c);
-                for q in &part {
-                    looked[(q.y * nx + q.x) as usize] = true;
-                }
-                let held = part.iter().any(|q| shell.get(q.offset(0, 0, -1)));
-                let over_hollow = part.iter().any(|q| emptied.get(q.offset(0, 0, -1)));
-                if held || !over_hollow {
-                    continue;
-                }
-                for k in 1..=up.min(z) {
-                    for q in &part {
-                        let below = Cell::new(q.x, q.y, z - k);
-                        for h in layer_part(emptied, below) {
-                            emptied.set(h, false);
-                            shell.set(h, true);
-                        }
-                    }
-                }
-            }
-        }
-    }
+    lid_where_unheld(shell, emptied, up, -1);
 }
 
 /// Gives every part of a layer's shell that stands wholly under the
 /// hollow (no cell of it has shell over it, and some has hollow) a lid of
-/// `up` layers over it: in each of those layers, the stretch of hollow
-/// over its cells is filled again, whole, so that what stands there is
-/// joined to the shell around (a pedestal under a wider body, two layers
-/// high: its rim stood under the body's hollow, joined to nothing, and
-/// was left out). The mirror of [`lid_under_hanging`]; layers go from the
-/// top down.
+/// `up` layers over it, the same way, so that what stands there is joined
+/// to the shell around (a pedestal under a wider body, two layers high:
+/// its rim stood under the body's hollow, joined to nothing, and was left
+/// out). The mirror of [`lid_under_hanging`]; layers go from the top down.
 fn lid_over_standing(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
+    lid_where_unheld(shell, emptied, up, 1);
+}
+
+/// [`lid_under_hanging`] (`dz` -1: the side looked at is under each part)
+/// and [`lid_over_standing`] (`dz` 1: over it). Layers go away from that
+/// side, so a lid made is in place when the layers beyond it are looked at.
+fn lid_where_unheld(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32, dz: i32) {
     let (nx, ny, nz) = shell.dims();
-    for z in (0..nz - 1).rev() {
+    let layers: Vec<i32> = if dz < 0 {
+        (1..nz).collect()
+    } else {
+        (0..nz - 1).rev().collect()
+    };
+    for z in layers {
+        // Layers on the side looked at, to the grid's end.
+        let room = if dz < 0 { z } else { nz - 1 - z };
         let mut looked = vec![false; (nx * ny) as usize];
         for y in 0..ny {
             for x in 0..nx {
@@ -286,15 +269,15 @@ fn lid_over_standing(shell: &mut VoxelGrid, emptied: &mut VoxelGrid, up: i32) {
                 for q in &part {
                     looked[(q.y * nx + q.x) as usize] = true;
                 }
-                let held = part.iter().any(|q| shell.get(q.offset(0, 0, 1)));
-                let under_hollow = part.iter().any(|q| emptied.get(q.offset(0, 0, 1)));
-                if held || !under_hollow {
+                let held = part.iter().any(|q| shell.get(q.offset(0, 0, dz)));
+                let by_hollow = part.iter().any(|q| emptied.get(q.offset(0, 0, dz)));
+                if held || !by_hollow {
                     continue;
                 }
-                for k in 1..=up.min(nz - 1 - z) {
+                for k in 1..=up.min(room) {
                     for q in &part {
-                        let above = Cell::new(q.x, q.y, z + k);
-                        for h in layer_part(emptied, above) {
+                        let side = Cell::new(q.x, q.y, z + dz * k);
+                        for h in layer_part(emptied, side) {
                             emptied.set(h, false);
                             shell.set(h, true);
                         }
