@@ -42,6 +42,33 @@ pub enum Shape {
     /// under its back row; the underside rises from the back row to a lip
     /// 4 LDU thick at the front.
     Inverted,
+    /// An outside corner slope (double convex, 3045): 2 x 2, full height
+    /// only at its back row's `-x` cell, whose one stud it carries; from
+    /// there its faces fall two ways, to the front (`-y`) as a slope's do
+    /// and to `+x`, meeting along a hip. Open below across its footprint.
+    Corner,
+    /// An inverted outside corner slope (3676): [`Shape::Corner`] upside
+    /// down, studs on its whole top, connecting below only under its
+    /// back row's `-x` cell.
+    InvertedCorner,
+}
+
+impl Shape {
+    /// Whether the part's faces slant up to its studs (slopes and corner
+    /// slopes; the inverted ones slant under it).
+    pub fn is_up(self) -> bool {
+        matches!(self, Shape::Slope | Shape::Corner)
+    }
+
+    /// Whether the part is a corner slope, up or inverted.
+    pub fn is_corner(self) -> bool {
+        matches!(self, Shape::Corner | Shape::InvertedCorner)
+    }
+
+    /// Whether the part's faces slant under it (inverted slopes).
+    pub fn is_inverted(self) -> bool {
+        matches!(self, Shape::Inverted | Shape::InvertedCorner)
+    }
 }
 
 /// How a part's geometry repeats under rotation about the vertical axis.
@@ -119,7 +146,9 @@ impl PartSpec {
     /// Brick, plate or slope.
     pub fn family(&self) -> Family {
         match (self.shape, self.height_plates) {
-            (Shape::Slope | Shape::Inverted, _) => Family::Slope,
+            (Shape::Slope | Shape::Inverted | Shape::Corner | Shape::InvertedCorner, _) => {
+                Family::Slope
+            }
             (Shape::Rect, 1) => Family::Plate,
             _ => Family::Brick,
         }
@@ -147,6 +176,43 @@ impl PartSpec {
         };
         let local = if self.shape == Shape::Rect {
             Body::solid(bbox)
+        } else if self.shape.is_corner() {
+            // The full cell (back row, -x) is the whole height; the other
+            // three are as high as a 45° slope's front row (the diagonal
+            // cell a little less, under the hip, counted the same).
+            let low = self.row_layers(layer_ldu)[1];
+            let full_cell = |z: i32, sz: i32| CellBox {
+                min: Cell::new(0, d - 1, z),
+                sx: 1,
+                sy: 1,
+                sz,
+            };
+            let (boxes, studs, tubes) = if self.shape == Shape::Corner {
+                (
+                    vec![CellBox { sz: low, ..bbox }, full_cell(low, full - low)],
+                    full_cell(full - 1, 1),
+                    CellBox { sz: 1, ..bbox },
+                )
+            } else {
+                (
+                    vec![
+                        full_cell(0, full - low),
+                        CellBox {
+                            min: Cell::new(0, 0, full - low),
+                            sz: low,
+                            ..bbox
+                        },
+                    ],
+                    CellBox {
+                        min: Cell::new(0, 0, full - 1),
+                        sz: 1,
+                        ..bbox
+                    },
+                    full_cell(0, 1),
+                )
+            };
+            let boxes: Vec<CellBox> = boxes.into_iter().filter(|b| b.sz > 0).collect();
+            Body::new(&boxes, bbox, studs, tubes)
         } else {
             let rows = self.row_layers(layer_ldu);
             // Rows filled in layer k, counted from the back: a slope's
@@ -185,6 +251,16 @@ impl PartSpec {
     /// row when turned by `rot`.
     pub fn back(&self, rot: Rot) -> (i32, i32) {
         rot.apply(0, 1)
+    }
+
+    /// The directions, in grid `(x, y)`, a slope's faces fall toward when
+    /// turned by `rot`: its front for a slope, its front and its `+x`
+    /// side for a corner slope; none for a brick or plate.
+    pub fn faces(&self, rot: Rot) -> impl Iterator<Item = (i32, i32)> {
+        let (bx, by) = self.back(rot);
+        let front = (self.shape != Shape::Rect).then_some((-bx, -by));
+        let side = self.shape.is_corner().then(|| rot.apply(1, 0));
+        front.into_iter().chain(side)
     }
 
     /// Height in LDU.
@@ -472,6 +548,27 @@ pub static PARTS: &[PartSpec] = &[
         3,
         2.93
     ),
+    // Outside corners, where two rows of slopes meet at a hip (on the
+    // rounded tops and undersides of organic models); masses published
+    // for the parts: 3045 0.98 g, 3676 1.16 g.
+    slope!(
+        "3045",
+        "3045",
+        "Slope Brick 45 2 x 2 Double Convex",
+        Shape::Corner,
+        2,
+        2,
+        0.98
+    ),
+    slope!(
+        "3676",
+        "3676",
+        "Slope Brick 45 2 x 2 Inverted Double Convex",
+        Shape::InvertedCorner,
+        2,
+        2,
+        1.16
+    ),
 ];
 
 #[cfg(test)]
@@ -519,6 +616,43 @@ mod tests {
         assert!(part("3001").body(Rot::R90, Cell::new(0, 0, 0), 24).is_box());
         assert_eq!(part("3020").body(Rot::R0, Cell::new(0, 0, 0), 8).bbox.sz, 1);
         assert_eq!(part("3001").body(Rot::R0, Cell::new(0, 0, 0), 8).bbox.sz, 3);
+    }
+
+    #[test]
+    fn corner_slopes_are_full_at_one_cell_and_fall_two_ways() {
+        let c = part("3045");
+        let b = c.body(Rot::R0, Cell::new(0, 0, 0), 12);
+        // The full cell, back row at -x, two layers; the other three one.
+        assert_eq!(b.volume(), 4 + 1);
+        assert!(b.contains(Cell::new(0, 1, 1)));
+        for q in [Cell::new(1, 1, 1), Cell::new(0, 0, 1), Cell::new(1, 0, 1)] {
+            assert!(!b.contains(q) && b.contains(q.offset(0, 0, -1)), "{q:?}");
+        }
+        assert_eq!(
+            (b.studs.min, b.studs.sx, b.studs.sy),
+            (Cell::new(0, 1, 1), 1, 1)
+        );
+        assert_eq!((b.tubes.sx, b.tubes.sy, b.tubes.min.z), (2, 2, 0));
+        assert_eq!(c.faces(Rot::R0).collect::<Vec<_>>(), vec![(0, -1), (1, 0)]);
+        assert_eq!(c.faces(Rot::R90).collect::<Vec<_>>(), vec![(1, 0), (0, 1)]);
+        assert_eq!(c.family(), Family::Slope);
+        // At 8 LDU a layer: three plates at the full cell, two elsewhere.
+        assert_eq!(c.body(Rot::R0, Cell::new(0, 0, 0), 8).volume(), 3 + 3 * 2);
+        // Upside down: studs on the whole top, held below at the full cell.
+        let inv = part("3676").body(Rot::R0, Cell::new(0, 0, 0), 12);
+        assert_eq!(inv.volume(), 4 + 1);
+        assert!(inv.contains(Cell::new(0, 1, 0)) && !inv.contains(Cell::new(1, 0, 0)));
+        assert_eq!(
+            (inv.tubes.min, inv.tubes.sx, inv.tubes.sy),
+            (Cell::new(0, 1, 0), 1, 1)
+        );
+        assert_eq!((inv.studs.sx, inv.studs.sy, inv.studs.min.z), (2, 2, 1));
+        // A brick's faces fall nowhere; a slope's to its front.
+        assert_eq!(part("3001").faces(Rot::R0).count(), 0);
+        assert_eq!(
+            part("3039").faces(Rot::R180).collect::<Vec<_>>(),
+            vec![(0, 1)]
+        );
     }
 
     #[test]

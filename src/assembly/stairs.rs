@@ -7,8 +7,9 @@
 //! neighbouring column's top (the four side neighbours; an empty
 //! neighbouring column is a wall, not a step). It is **capped** when the
 //! piece at the top of the higher column is a slope whose low side (its
-//! front) faces down the step, towards the lower neighbour: a roof built of
-//! slopes reads as a roof, a roof of bricks as a staircase.
+//! front, or either of a corner slope's two) faces down the step, towards
+//! the lower neighbour: a roof built of slopes reads as a roof, a roof of
+//! bricks as a staircase.
 //!
 //! The **underside** is the same upside down: a column whose lowest cell
 //! hangs one to three plates below a neighbour's lowest cell (the eaves of
@@ -33,7 +34,6 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use super::Assembly;
-use crate::catalog::Shape;
 
 /// A count on the top surface and on the underside.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
@@ -150,14 +150,16 @@ pub fn stair_edges(asm: &Assembly) -> StairEdges {
     let u = asm.layer_ldu.max(1);
     let is_step = |layers: i32| (8..=24).contains(&(layers * u));
     // The piece faces from column `a` towards its neighbour at `dir`: its
-    // front (low side) is that way.
-    let faces = |piece: usize, shape: Shape, dir: (i32, i32)| {
+    // front (low side), or a corner slope's other low side, is that way.
+    let faces = |piece: usize, up: bool, dir: (i32, i32)| {
         let p = &asm.pieces[piece].placement;
         let spec = p.part.spec();
-        spec.shape == shape && {
-            let (bx, by) = spec.back(p.rot);
-            (-bx, -by) == dir
-        }
+        let kind = if up {
+            spec.shape.is_up()
+        } else {
+            spec.shape.is_inverted()
+        };
+        kind && spec.faces(p.rot).any(|f| f == dir)
     };
     let mut keys: Vec<&(i32, i32)> = cols.keys().collect();
     keys.sort();
@@ -170,11 +172,11 @@ pub fn stair_edges(asm: &Assembly) -> StairEdges {
             };
             if is_step(a.high - b.high) {
                 out.edges.top += 1;
-                out.capped.top += usize::from(faces(a.high_piece, Shape::Slope, dir));
+                out.capped.top += usize::from(faces(a.high_piece, true, dir));
             }
             if is_step(b.low - a.low) {
                 out.edges.underside += 1;
-                out.capped.underside += usize::from(faces(a.low_piece, Shape::Inverted, dir));
+                out.capped.underside += usize::from(faces(a.low_piece, false, dir));
             }
         }
     }

@@ -13,7 +13,10 @@
 //!   `y = 0` down to `y = 8 * height_plates`, the studs stand up to `y = -4`;
 //!   the long side lies along X (`x` in `±10·studs_x`, `z` in `±10·studs_y`);
 //! - slopes and inverted slopes: the centre of the studded back row (`z` from
-//!   `+10` at the back to `10 - 20·depth` at the front, toward -Z).
+//!   `+10` at the back to `10 - 20·depth` at the front, toward -Z);
+//! - corner slopes (3045) and inverted corner slopes (3676): the centre of
+//!   the top of the full-height cell, on the back row at -X (`x` from `-10`
+//!   to `20·studs_x - 10`, `z` from `+10` to `10 - 20·depth`).
 //!
 //! A piece's world position is then exactly the `.ldr` line's:
 //! `world = rot_matrix(rot)·local + placement_position(p, layer_ldu)`, the
@@ -26,10 +29,15 @@
 //! back row's flat top along its slanted face to a lip 4 LDU high at the
 //! front (45° over one row for 3039, 33° over two rows for 3298, as in the
 //! LDraw files); an inverted slope is flat on top and its underside rises
-//! from the back row to a 4 LDU lip. Studs are 16-sided cylinders of radius
-//! 6 LDU and height 4 on the studded cells (every top cell, a slope's back
-//! row only). Bodies are solid: no hollow underside or tubes, which a
-//! picture of an assembled model never shows.
+//! from the back row to a 4 LDU lip. A corner slope (3045) is the
+//! intersection of two such slope prisms at right angles: from its one
+//! full-height cell its faces fall at 45° to +X and to -Z, meeting along a
+//! hip, down to 4 LDU lips; an inverted corner slope (3676) is the same solid
+//! upside down, its underside rising from its one full-height cell. Studs
+//! are 16-sided cylinders of radius 6 LDU and height 4 on the studded cells
+//! (every top cell, a slope's back row only, a corner slope's full cell
+//! only). Bodies are solid: no hollow underside or tubes, which a picture of
+//! an assembled model never shows.
 //!
 //! Each mesh is one closed, watertight surface: the top face is cut around
 //! each stud's foot and every face carries the vertices its neighbours put
@@ -181,6 +189,9 @@ pub fn piece_transform(p: &Placement, layer_ldu: i32) -> Affine3A {
 
 /// Builds the mesh of one catalog entry (uncached; see [`part_mesh`]).
 pub fn build_part_mesh(spec: &PartSpec) -> PartMesh {
+    if spec.shape.is_corner() {
+        return build_corner_mesh(spec, false);
+    }
     let (profile, hx, columns, rows) = layout(spec);
     let mut b = Builder::default();
     b.studded_top(&columns, &rows);
@@ -192,6 +203,9 @@ pub fn build_part_mesh(spec: &PartSpec) -> PartMesh {
 
 /// Builds the mesh of [`coarse_part_mesh`] (uncached).
 pub fn build_coarse_part_mesh(spec: &PartSpec) -> PartMesh {
+    if spec.shape.is_corner() {
+        return build_corner_mesh(spec, true);
+    }
     let (profile, hx, columns, rows) = layout(spec);
     let mut b = Builder::default();
     b.prism(&profile, hx, &[], &[]);
@@ -206,24 +220,38 @@ pub fn build_coarse_part_mesh(spec: &PartSpec) -> PartMesh {
     b.mesh
 }
 
-/// A part's profile, half width and the centres of its stud columns (x)
-/// and rows (z).
+/// A prism part's profile, half width and the centres of its stud columns
+/// (x) and rows (z).
 fn layout(spec: &PartSpec) -> (Profile, f32, Vec<f32>, Vec<f32>) {
     let w = i32::from(spec.studs_x.max(1));
     let d = i32::from(spec.studs_y.max(1));
     let h = spec.height_ldu().max(8) as f32;
-    let columns: Vec<f32> = (0..w).map(|i| (20 * i - 10 * w + 10) as f32).collect();
-    let rows: Vec<f32> = match spec.shape {
-        Shape::Rect => (0..d).map(|j| (20 * j - 10 * d + 10) as f32).collect(),
-        Shape::Slope => vec![0.0],
-        Shape::Inverted => (0..d).rev().map(|j| (-20 * j) as f32).collect(),
-    };
+    let (columns, rows) = stud_grid(spec);
     (
         Profile::of(spec.shape, d, h),
         10.0 * w as f32,
         columns,
         rows,
     )
+}
+
+/// The centres of a part's studded cells: its columns (x) and rows (z).
+fn stud_grid(spec: &PartSpec) -> (Vec<f32>, Vec<f32>) {
+    let w = i32::from(spec.studs_x.max(1));
+    let d = i32::from(spec.studs_y.max(1));
+    let centred: Vec<f32> = (0..w).map(|i| (20 * i - 10 * w + 10) as f32).collect();
+    let from_back = || (0..d).rev().map(|j| (-20 * j) as f32).collect();
+    match spec.shape {
+        Shape::Rect => (
+            centred,
+            (0..d).map(|j| (20 * j - 10 * d + 10) as f32).collect(),
+        ),
+        Shape::Slope => (centred, vec![0.0]),
+        Shape::Inverted => (centred, from_back()),
+        // The origin is on the -X back cell: columns run from it toward +X.
+        Shape::Corner => (vec![0.0], vec![0.0]),
+        Shape::InvertedCorner => ((0..w).map(|i| (20 * i) as f32).collect(), from_back()),
+    }
 }
 
 /// Offsets, from a cell's centre, of the 16 points where rays from the
@@ -279,7 +307,9 @@ fn edge_points(centres: &[f32]) -> Vec<f32> {
 
 /// A prism's cross-section in the `(z, y)` plane: convex corners in order,
 /// starting at the bottom back corner, then the back top corner; the edge
-/// from corner 1 to corner 2 is the (studded) top.
+/// from corner 1 to corner 2 is the (studded) top. A corner slope is no
+/// prism (its faces come from [`corner_faces`]); its profile here is its
+/// slope's, its section across its full cell (its face at `x = -10`).
 struct Profile {
     corners: Vec<[f32; 2]>,
 }
@@ -292,14 +322,14 @@ impl Profile {
                 let hz = 10.0 * depth as f32;
                 vec![[hz, h], [hz, 0.0], [-hz, 0.0], [-hz, h]]
             }
-            Shape::Slope => vec![
+            Shape::Slope | Shape::Corner => vec![
                 [10.0, h],
                 [10.0, 0.0],
                 [-10.0, 0.0],
                 [front, h - LIP_HEIGHT],
                 [front, h],
             ],
-            Shape::Inverted => vec![
+            Shape::Inverted | Shape::InvertedCorner => vec![
                 [10.0, h],
                 [10.0, 0.0],
                 [front, 0.0],
@@ -318,6 +348,189 @@ impl Profile {
             .fold((0.0, 0.0), |(z, y), c| (z + c[0], y + c[1]));
         [z / n, y / n]
     }
+}
+
+/// A planar face: its corners in order and a vector pointing out of the
+/// solid.
+type Face = (Vec<Vec3>, Vec3);
+
+/// Builds a corner slope's mesh ([`Shape::Corner`], [`Shape::InvertedCorner`]):
+/// its convex body's faces, each carrying every vertex that another face
+/// (or the studded top's cells) puts on its edges, with the studded top and
+/// full studs, or with `coarse` a plain top and [`Builder::stud_prism`]s.
+fn build_corner_mesh(spec: &PartSpec, coarse: bool) -> PartMesh {
+    let (columns, rows) = stud_grid(spec);
+    let (top, mut faces) = corner_faces(spec);
+    let mut b = Builder::default();
+    if coarse {
+        faces.insert(0, top);
+    } else {
+        b.studded_top(&columns, &rows);
+    }
+    let mut points: Vec<Vec3> = faces.iter().flat_map(|f| f.0.iter().copied()).collect();
+    if !coarse {
+        // The points the studded cells put on their squares' edges, computed
+        // exactly as `studded_top` does.
+        for &cz in &rows {
+            for &cx in &columns {
+                points.extend(
+                    square_points()
+                        .iter()
+                        .map(|o| Vec3::new(cx + o[0], 0.0, cz + o[1])),
+                );
+            }
+        }
+    }
+    for (corners, outward) in &faces {
+        b.convex_face(&with_edge_points(corners, &points), *outward);
+    }
+    if coarse {
+        for &cz in &rows {
+            for &cx in &columns {
+                b.stud_prism(cx, cz);
+            }
+        }
+    }
+    b.mesh
+}
+
+/// A corner slope's faces: its studded top (the full cell's square for
+/// 3045, the whole footprint for 3676) and the others.
+///
+/// The upright solid (3045) is the points of its footprint (`x` from -10 to
+/// `far`, `z` from `front` to +10) between `y = 0` and the bottom `y = h`,
+/// and under both slanted planes: face A through the line `x = 10, y = 0`
+/// and `x = far, y = h - lip`, face B through `z = -10, y = 0` and
+/// `z = front, y = h - lip`. They meet along the hip from `(10, 0, -10)` to
+/// `(far, h - lip, front)`. Its faces at `x = -10` and `z = +10` are the
+/// slope's [`Profile`]. The inverted solid (3676) is the same mirrored
+/// through `y = h / 2`.
+fn corner_faces(spec: &PartSpec) -> (Face, Vec<Face>) {
+    let h = spec.height_ldu().max(8) as f32;
+    let far = (20 * i32::from(spec.studs_x.max(2)) - 10) as f32;
+    let front = (10 - 20 * i32::from(spec.studs_y.max(2))) as f32;
+    let low = h - LIP_HEIGHT;
+    let p = Vec3::new;
+    let mut faces: Vec<Face> = vec![
+        // The full cell's top.
+        (
+            vec![
+                p(-10.0, 0.0, 10.0),
+                p(10.0, 0.0, 10.0),
+                p(10.0, 0.0, -10.0),
+                p(-10.0, 0.0, -10.0),
+            ],
+            Vec3::NEG_Y,
+        ),
+        // Face A, falling toward +X.
+        (
+            vec![
+                p(10.0, 0.0, 10.0),
+                p(10.0, 0.0, -10.0),
+                p(far, low, front),
+                p(far, low, 10.0),
+            ],
+            Vec3::new(low, 10.0 - far, 0.0),
+        ),
+        // Face B, falling toward -Z.
+        (
+            vec![
+                p(10.0, 0.0, -10.0),
+                p(-10.0, 0.0, -10.0),
+                p(-10.0, low, front),
+                p(far, low, front),
+            ],
+            Vec3::new(0.0, front + 10.0, -low),
+        ),
+        // The lips.
+        (
+            vec![
+                p(far, low, 10.0),
+                p(far, low, front),
+                p(far, h, front),
+                p(far, h, 10.0),
+            ],
+            Vec3::X,
+        ),
+        (
+            vec![
+                p(-10.0, low, front),
+                p(far, low, front),
+                p(far, h, front),
+                p(-10.0, h, front),
+            ],
+            Vec3::NEG_Z,
+        ),
+        // The back faces.
+        (
+            vec![
+                p(-10.0, h, 10.0),
+                p(-10.0, 0.0, 10.0),
+                p(10.0, 0.0, 10.0),
+                p(far, low, 10.0),
+                p(far, h, 10.0),
+            ],
+            Vec3::Z,
+        ),
+        (
+            vec![
+                p(-10.0, h, 10.0),
+                p(-10.0, 0.0, 10.0),
+                p(-10.0, 0.0, -10.0),
+                p(-10.0, low, front),
+                p(-10.0, h, front),
+            ],
+            Vec3::NEG_X,
+        ),
+        // The bottom.
+        (
+            vec![
+                p(-10.0, h, 10.0),
+                p(far, h, 10.0),
+                p(far, h, front),
+                p(-10.0, h, front),
+            ],
+            Vec3::Y,
+        ),
+    ];
+    if spec.shape == Shape::InvertedCorner {
+        let flip = |v: Vec3| Vec3::new(v.x, h - v.y, v.z);
+        for (corners, outward) in &mut faces {
+            for c in corners.iter_mut() {
+                *c = flip(*c);
+            }
+            outward.y = -outward.y;
+        }
+        // The bottom, turned over, is the studded top.
+        faces.rotate_right(1);
+    }
+    let top = faces.remove(0);
+    (top, faces)
+}
+
+/// The polygon `corners` with, on each edge, every point of `points` lying
+/// strictly inside that edge inserted in order along it (duplicates once).
+fn with_edge_points(corners: &[Vec3], points: &[Vec3]) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for (i, &a) in corners.iter().enumerate() {
+        let b = corners[(i + 1) % corners.len()];
+        let e = b - a;
+        let len2 = e.length_squared();
+        let mut on: Vec<(f32, Vec3)> = points
+            .iter()
+            .filter(|&&q| q != a && q != b)
+            .filter_map(|&q| {
+                let t = (q - a).dot(e) / len2;
+                let off = (q - a).cross(e).length_squared() / len2;
+                (t > 0.0 && t < 1.0 && off < 1e-6).then_some((t, q))
+            })
+            .collect();
+        on.sort_by(|x, y| x.0.total_cmp(&y.0));
+        on.dedup_by(|x, y| x.1 == y.1);
+        out.push(a);
+        out.extend(on.into_iter().map(|(_, q)| q));
+    }
+    out
 }
 
 /// Accumulates faces, sharing a vertex only between triangles with the
@@ -365,6 +578,33 @@ impl Builder {
                 (ids[i], ids[i + 1])
             };
             self.mesh.indices.extend([ids[0], b, c]);
+        }
+    }
+
+    /// A planar convex polygon whose edges may carry intermediate points
+    /// (`pts` in order): fanned from a corner whose two edges carry none,
+    /// or if there is no such corner, from a new vertex at the corners'
+    /// centroid.
+    fn convex_face(&mut self, pts: &[Vec3], outward: Vec3) {
+        let n = pts.len();
+        if n < 3 {
+            return;
+        }
+        let corner = |i: usize| {
+            let (a, b, c) = (pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]);
+            let (u, v) = (b - a, c - b);
+            u.cross(v).length_squared() > 1e-6 * u.length_squared() * v.length_squared()
+        };
+        let apex = (0..n).find(|&i| corner(i) && corner((i + 1) % n) && corner((i + n - 1) % n));
+        if let Some(i) = apex {
+            let fan: Vec<Vec3> = pts[i..].iter().chain(&pts[..i]).copied().collect();
+            self.polygon(&fan, outward);
+            return;
+        }
+        let corners: Vec<Vec3> = (0..n).filter(|&i| corner(i)).map(|i| pts[i]).collect();
+        let centre = corners.iter().copied().sum::<Vec3>() / corners.len().max(1) as f32;
+        for i in 0..n {
+            self.polygon(&[centre, pts[i], pts[(i + 1) % n]], outward);
         }
     }
 
@@ -521,6 +761,21 @@ mod tests {
             Shape::Slope => (20.0 * w * (20.0 * h + run * (h + lip) / 2.0), w),
             // The same solid upside down, with studs on every cell.
             Shape::Inverted => (20.0 * w * (20.0 * h + run * (h + lip) / 2.0), w * d),
+            // The full cell, two strips under one slanted face (a slope's
+            // trapezoid), and the square under the hip: there the depth is
+            // h less the drop, which is the larger of two uniform ones.
+            Shape::Corner | Shape::InvertedCorner => {
+                let drop = h - lip;
+                let body = 20.0 * 20.0 * h
+                    + 2.0 * 20.0 * run * (h + lip) / 2.0
+                    + run * run * (h - 2.0 * drop / 3.0);
+                let studs = if spec.shape == Shape::Corner {
+                    1.0
+                } else {
+                    w * d
+                };
+                (body, studs)
+            }
         };
         body + studs * stud_area() * f64::from(STUD_HEIGHT)
     }
@@ -535,6 +790,14 @@ mod tests {
             Shape::Slope => stud * w + (4 * w + 1) + 2 * 6 + (4 * w + 1) + 2 + 2,
             // Back wall, 2 end caps, front lip, underside, bottom.
             Shape::Inverted => stud * w * d + (4 * w + 1) + 2 * (4 * d + 2) + (4 * w + 1) + 4,
+            // Two slanted quads carrying the stud's 3 points on their top
+            // edge, two back pentagons carrying them too, two lips, bottom.
+            Shape::Corner => stud + 2 * 5 + 2 * 6 + 2 * 2 + 2,
+            // Two back pentagons and two lips along the top's outer edges
+            // (4 points a cell, less one), two slanted quads, bottom.
+            Shape::InvertedCorner => {
+                stud * w * d + (4 * w + 2) + (4 * d + 2) + (4 * d + 1) + (4 * w + 1) + 3 * 2
+            }
         }
     }
 
@@ -606,7 +869,13 @@ mod tests {
                 Shape::Rect => (-hz, hz),
                 _ => (10.0 - 2.0 * hz, 10.0),
             };
-            let want = ([-hx, -STUD_HEIGHT, zlo], [hx, s.height_ldu() as f32, zhi]);
+            // A corner slope's origin is on its -X cell.
+            let (xlo, xhi) = if s.shape.is_corner() {
+                (-10.0, 2.0 * hx - 10.0)
+            } else {
+                (-hx, hx)
+            };
+            let want = ([xlo, -STUD_HEIGHT, zlo], [xhi, s.height_ldu() as f32, zhi]);
             assert_eq!(part_mesh(part).bounds(), Some(want), "{part}");
         }
     }
@@ -633,33 +902,171 @@ mod tests {
         assert!(n[1] < -0.85 && n[2] < -0.4, "{n:?}");
     }
 
+    /// Panics unless `m` is one closed surface: welded by position, every
+    /// directed edge is used once and its reverse once.
+    fn assert_closed(m: &PartMesh, part: PartKind) {
+        let mut ids: HashMap<[u32; 3], usize> = HashMap::new();
+        let weld: Vec<usize> = m
+            .positions
+            .iter()
+            .map(|p| {
+                let n = ids.len();
+                *ids.entry(p.map(f32::to_bits)).or_insert(n)
+            })
+            .collect();
+        let mut edges: BTreeMap<(usize, usize), i32> = BTreeMap::new();
+        for t in m.indices.chunks_exact(3) {
+            let v = [0, 1, 2].map(|k| weld[t[k] as usize]);
+            assert!(v[0] != v[1] && v[1] != v[2] && v[0] != v[2], "{part}");
+            for k in 0..3 {
+                *edges.entry((v[k], v[(k + 1) % 3])).or_default() += 1;
+            }
+        }
+        assert!(!edges.is_empty(), "{part}: empty mesh");
+        for (&(a, b), &n) in &edges {
+            assert_eq!(n, 1, "{part}: edge {a}->{b} used {n} times");
+            assert_eq!(edges.get(&(b, a)), Some(&1), "{part}: edge {a}->{b} open");
+        }
+    }
+
     #[test]
     fn meshes_are_closed_and_consistently_wound() {
         for part in PartKind::all() {
-            let m = part_mesh(part);
-            // Weld by position, then count directed edges.
-            let mut ids: HashMap<[u32; 3], usize> = HashMap::new();
-            let weld: Vec<usize> = m
-                .positions
-                .iter()
-                .map(|p| {
-                    let n = ids.len();
-                    *ids.entry(p.map(f32::to_bits)).or_insert(n)
-                })
-                .collect();
-            let mut edges: BTreeMap<(usize, usize), i32> = BTreeMap::new();
-            for t in m.indices.chunks_exact(3) {
-                let v = [0, 1, 2].map(|k| weld[t[k] as usize]);
-                assert!(v[0] != v[1] && v[1] != v[2] && v[0] != v[2], "{part}");
-                for k in 0..3 {
-                    *edges.entry((v[k], v[(k + 1) % 3])).or_default() += 1;
-                }
+            assert_closed(part_mesh(part), part);
+        }
+    }
+
+    /// The heights `y` of `m`'s surface over the point `(x, z)`.
+    fn heights_over(m: &PartMesh, x: f32, z: f32) -> Vec<f32> {
+        let mut out = Vec::new();
+        for [a, b, c] in m.triangles() {
+            let d = (b.x - a.x) * (c.z - a.z) - (c.x - a.x) * (b.z - a.z);
+            if d.abs() < 1e-6 {
+                continue; // vertical
             }
-            for (&(a, b), &n) in &edges {
-                assert_eq!(n, 1, "{part}: edge {a}->{b} used {n} times");
-                assert_eq!(edges.get(&(b, a)), Some(&1), "{part}: edge {a}->{b} open");
+            let u = ((x - a.x) * (c.z - a.z) - (c.x - a.x) * (z - a.z)) / d;
+            let v = ((b.x - a.x) * (z - a.z) - (x - a.x) * (b.z - a.z)) / d;
+            if u >= -1e-5 && v >= -1e-5 && u + v <= 1.0 + 1e-5 {
+                out.push(a.y + u * (b.y - a.y) + v * (c.y - a.y));
             }
         }
+        out
+    }
+
+    /// How many studs `m` has: distinct vertices on the studs' caps, a
+    /// cap having `segments`.
+    fn studs(m: &PartMesh, segments: usize) -> usize {
+        let mut caps: Vec<[u32; 3]> = m
+            .positions
+            .iter()
+            .filter(|p| p[1] == -STUD_HEIGHT)
+            .map(|p| p.map(f32::to_bits))
+            .collect();
+        caps.sort_unstable();
+        caps.dedup();
+        assert_eq!(caps.len() % segments, 0);
+        caps.len() / segments
+    }
+
+    #[test]
+    fn corner_slopes_are_closed_and_watertight() {
+        for id in ["3045", "3676"] {
+            let part = PartKind::from_id(id).unwrap();
+            assert!(part.spec().shape.is_corner());
+            assert_closed(part_mesh(part), part);
+        }
+        assert_eq!(mesh("3045").triangle_count(), 106);
+        assert_eq!(mesh("3676").triangle_count(), 356);
+    }
+
+    #[test]
+    fn corner_slopes_span_their_ldraw_footprints() {
+        let want = Some(([-10.0, -4.0, -30.0], [30.0, 24.0, 10.0]));
+        for id in ["3045", "3676"] {
+            let part = PartKind::from_id(id).unwrap();
+            assert_eq!(part_mesh(part).bounds(), want, "{id}");
+            assert_eq!(coarse_part_mesh(part).bounds(), want, "{id}");
+        }
+    }
+
+    #[test]
+    fn corner_slopes_have_their_studs() {
+        // 3045's one stud stands on its full cell, at the origin.
+        assert_eq!(studs(mesh("3045"), STUD_SEGMENTS), 1);
+        assert!(mesh("3045")
+            .positions
+            .iter()
+            .filter(|p| p[1] == -STUD_HEIGHT)
+            .all(|p| p[0].hypot(p[2]) <= STUD_RADIUS + 1e-4));
+        assert_eq!(studs(mesh("3676"), STUD_SEGMENTS), 4);
+        let coarse = |id| coarse_part_mesh(PartKind::from_id(id).unwrap());
+        assert_eq!(studs(coarse("3045"), COARSE_STUD_SEGMENTS), 1);
+        assert_eq!(studs(coarse("3676"), COARSE_STUD_SEGMENTS), 4);
+        // 3676's studs are on its four cells' centres.
+        for (x, z) in [(0.0, 0.0), (20.0, 0.0), (0.0, -20.0), (20.0, -20.0)] {
+            let top = heights_over(mesh("3676"), x, z);
+            assert!(top.contains(&-STUD_HEIGHT), "({x}, {z}): {top:?}");
+        }
+    }
+
+    #[test]
+    fn corner_slopes_have_their_measured_faces() {
+        // 3045.dat: the faces fall from y 0 at the full cell's edges to
+        // y 20 at the lips, meeting along the hip (10, 0, -10)-(30, 20, -30).
+        let top = |m: &PartMesh, x, z| {
+            heights_over(m, x, z)
+                .into_iter()
+                .fold(f32::INFINITY, f32::min)
+        };
+        let under = |m: &PartMesh, x, z| {
+            heights_over(m, x, z)
+                .into_iter()
+                .fold(f32::NEG_INFINITY, f32::max)
+        };
+        let s = mesh("3045");
+        assert_eq!(top(s, 20.0, 0.0), 10.0); // face A
+        assert_eq!(top(s, 0.0, -20.0), 10.0); // face B
+        assert_eq!(top(s, 20.0, -20.0), 10.0); // the hip
+        assert!((top(s, 25.0, -15.0) - 15.0).abs() < 1e-4); // A beside the hip
+        assert!((top(s, 15.0, -25.0) - 15.0).abs() < 1e-4); // B beside the hip
+        assert_eq!(top(s, 30.0, -30.0), 20.0);
+        assert_eq!(under(s, 20.0, -20.0), 24.0);
+        let has = |m: &PartMesh, p: [f32; 3]| m.positions.contains(&p);
+        assert!(has(s, [10.0, 0.0, -10.0]) && has(s, [30.0, 20.0, -30.0]));
+        // Face A's normal points up (-Y) and toward +X, B's up and toward -Z.
+        let normal_at = |m: &PartMesh, p: [f32; 3], keep: fn(&[f32; 3]) -> bool| {
+            m.positions
+                .iter()
+                .zip(&m.normals)
+                .find(|(q, n)| **q == p && keep(n))
+                .map(|(_, n)| *n)
+                .unwrap()
+        };
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        let a = normal_at(s, [30.0, 20.0, 10.0], |n| n[0] > 0.1 && n[1] < -0.1);
+        assert!(
+            (Vec3::from(a) - Vec3::new(h, -h, 0.0)).length() < 1e-5,
+            "{a:?}"
+        );
+        let b = normal_at(s, [-10.0, 20.0, -30.0], |n| n[2] < -0.1 && n[1] < -0.1);
+        assert!(
+            (Vec3::from(b) - Vec3::new(0.0, -h, -h)).length() < 1e-5,
+            "{b:?}"
+        );
+        // 3676.dat: the underside rises from y 24 under the full cell to
+        // y 4 at the lips.
+        let inv = mesh("3676");
+        assert_eq!(under(inv, 20.0, 0.0), 14.0);
+        assert_eq!(under(inv, 0.0, -20.0), 14.0);
+        assert_eq!(under(inv, 20.0, -20.0), 14.0);
+        assert_eq!(under(inv, 0.0, 0.0), 24.0);
+        assert_eq!(under(inv, 30.0, -30.0), 4.0);
+        assert!(has(inv, [10.0, 24.0, -10.0]) && has(inv, [30.0, 4.0, -30.0]));
+        let a = normal_at(inv, [30.0, 4.0, 10.0], |n| n[0] > 0.1 && n[1] > 0.1);
+        assert!(
+            (Vec3::from(a) - Vec3::new(h, h, 0.0)).length() < 1e-5,
+            "{a:?}"
+        );
     }
 
     #[test]

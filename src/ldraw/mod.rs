@@ -157,6 +157,13 @@ pub(crate) fn origin_offset(part: PartKind, rot: Rot) -> (i64, i64) {
     if spec.shape == Shape::Rect {
         return (0, 0);
     }
+    if spec.shape.is_corner() {
+        // On its one full cell: back row, -X (measured from 3045.dat and
+        // 3676.dat).
+        let half = i64::from(LDU_PER_STUD) / 2;
+        let (x, z) = rot.apply(-1, 1);
+        return (half * i64::from(x), half * i64::from(z));
+    }
     let d = i64::from(LDU_PER_STUD) / 2 * (i64::from(spec.studs_y) - 1);
     let (bx, by) = spec.back(rot);
     (d * i64::from(bx), d * i64::from(by))
@@ -354,6 +361,12 @@ mod tests {
             } else {
                 (10 - 2 * hz, 10)
             };
+            // A corner slope's origin is on its full cell, at -X.
+            let (xlo, xhi) = if s.shape.is_corner() {
+                (-10, 2 * hx - 10)
+            } else {
+                (-hx, hx)
+            };
             let h = 8 * s.height_plates as i32;
             for r in Rot::ALL {
                 let p = Placement {
@@ -363,7 +376,7 @@ mod tests {
                 };
                 let pos = placement_position(&p, 8).map(|v| v as i32);
                 let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
-                for cx in [-hx, hx] {
+                for cx in [xlo, xhi] {
                     for cy in [0, h] {
                         for cz in [zlo, zhi] {
                             let w = mul(rot_matrix(r), [cx, cy, cz]);

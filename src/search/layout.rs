@@ -44,7 +44,7 @@ use super::prepare::{neighbors6, Repairs};
 use super::rulebook::RuleBook;
 use super::{Dice, SearchOptions, SearchStats};
 use crate::assembly::Placement;
-use crate::catalog::{Color, PartKind, Shape, COLORS};
+use crate::catalog::{Color, PartKind, COLORS};
 use crate::geom::{Body, Cell, Rot};
 use crate::grammar::{Dir, RuleSet};
 use crate::voxel::{Slant, VoxelGrid};
@@ -651,6 +651,11 @@ impl<'a> Layout<'a> {
     fn best(&mut self, c: Cell, reach: Reach, rng: &mut impl Rng) -> Option<Candidate> {
         let mut best: Option<Candidate> = None;
         for s in 0..self.shapes.len() {
+            // Corner slopes are the cap pass's, laid where two rows of
+            // slopes meet (see `cap::corners`).
+            if self.shapes[s].part.spec().shape.is_corner() {
+                continue;
+            }
             let layer = c.z.rem_euclid(self.phase) as usize;
             for k in 0..self.shapes[s].keys[layer].len() {
                 let key = self.shapes[s].keys[layer][k];
@@ -757,7 +762,7 @@ impl<'a> Layout<'a> {
         // top, that is over every column of the box with no stud (a 33°
         // slope's middle row is filled but slants too).
         let spec = p.part.spec();
-        let up = spec.shape == Shape::Slope;
+        let up = spec.shape.is_up();
         let dz = if up { 1 } else { -1 };
         let blocked = |n: Cell| self.must.in_bounds(n) && (self.must.get(n) || !self.free(n));
         // On top, the whole course over the face: the model starting half
@@ -791,12 +796,16 @@ impl<'a> Layout<'a> {
         let Some(slant) = self.slant else {
             return true;
         };
-        let (bx, by) = spec.back(p.rot);
-        let Some(g) = slant.facing((-bx, -by), up) else {
+        // A corner slope's faces fall two ways: the mesh slants either.
+        let grids: Vec<_> = spec
+            .faces(p.rot)
+            .filter_map(|f| slant.facing(f, up))
+            .collect();
+        if grids.is_empty() {
             return true;
-        };
+        }
         let inward = if up { -1 } else { 1 };
-        open().any(|q| (0..=depth).any(|k| g.get(q.offset(0, 0, inward * k))))
+        open().any(|q| (0..=depth).any(|k| grids.iter().any(|g| g.get(q.offset(0, 0, inward * k)))))
     }
 
     /// Whether a piece's box lies right under the box `b` somewhere (a

@@ -49,6 +49,7 @@
 //! way into wider ones (two 2x2 slopes into a 2x4), each merge undone
 //! with the swaps if they are.
 
+mod corner;
 mod line;
 
 use super::layout::{Layout, Reach};
@@ -358,6 +359,13 @@ impl Layout<'_> {
                         });
                     }
                 }
+            }
+        }
+        // Then the corners where the rows of slopes end.
+        (budget.per_swap, budget.min_yield) = (MAX_ADDED, 0);
+        for (kind, wanted) in [(Shape::Slope, top), (Shape::Inverted, under)] {
+            if wanted {
+                swaps.extend(self.cap_corners(kind, &mut budget));
             }
         }
         (swaps, budget)
@@ -701,19 +709,7 @@ impl Layout<'_> {
             return None;
         }
         // The pieces the brick joined, which the new ones must still join.
-        let joined: Vec<u32> = {
-            let mut v: Vec<u32> = self
-                .below(&p.body)
-                .into_iter()
-                .filter(|&o| self.joined_by_rule(o, id))
-                .collect();
-            v.extend(
-                self.above(&p.body)
-                    .into_iter()
-                    .filter(|&o| self.joined_by_rule(id, o)),
-            );
-            v
-        };
+        let joined = self.joined_with(id);
         self.remove(id);
         for (n, _, all, slopes) in plans {
             // Pieces it adds to the build: within the swap's and the whole
@@ -741,6 +737,22 @@ impl Layout<'_> {
         }
         self.restore(id);
         None
+    }
+
+    /// The pieces piece `id` joins through the rules, under it and over it.
+    fn joined_with(&self, id: u32) -> Vec<u32> {
+        let body = self.pieces[id as usize].body;
+        let mut v: Vec<u32> = self
+            .below(&body)
+            .into_iter()
+            .filter(|&o| self.joined_by_rule(o, id))
+            .collect();
+        v.extend(
+            self.above(&body)
+                .into_iter()
+                .filter(|&o| self.joined_by_rule(id, o)),
+        );
+        v
     }
 
     /// The slopes (`deep` rows deep, `deep - 1` of them in brick box `b`)
