@@ -406,3 +406,18 @@ fn nothing_is_left_out_over_a_slope_within_a_course() {
         }
     }
 }
+
+#[test]
+fn no_piece_takes_the_cells_over_a_slopes_face() {
+    // With plates and slopes (layers a plate high) a plate laid over a
+    // slope's front row could take a cell of the slope's box, over its
+    // face: the two pieces would meet, and the build failed verification
+    // (the mug at 32 studs: pieces #266 and #307 overlapped).
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/mug.obj");
+    let rules = default_rules();
+    assert_eq!(rules.layer_ldu(), 8);
+    for studs in [32, 36] {
+        let asm = build_by(&path, studs, &rules);
+        assert!(slopes(&asm) > 0, "{studs} studs");
+    }
+}

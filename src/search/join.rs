@@ -390,7 +390,7 @@ impl Layout<'_> {
         let body = s.body_at(origin);
         let mut extra = 0;
         for q in body.cells() {
-            if !self.must.in_bounds(q) || self.kept_empty(q) {
+            if !self.must.in_bounds(q) || self.kept_empty(q) || self.shaded(q) {
                 return;
             }
             match self.owner_of(q) {

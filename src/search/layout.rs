@@ -274,6 +274,11 @@ pub(crate) struct Layout<'a> {
     pub weights: Weights,
     /// The piece owning each cell, or [`NONE`].
     pub owner: Vec<u32>,
+    /// The slope whose box holds each cell its face passes over (its open
+    /// cells), or [`NONE`]: no other piece may take such a cell, as no two
+    /// pieces' boxes may meet (the verifier's rule; with plates a piece
+    /// laid a plate over a slope's front row could take it).
+    shade: Vec<u32>,
     pub pieces: Vec<Laid>,
     pub groups: Vec<Group>,
     pub uf: UnionFind,
@@ -378,6 +383,7 @@ impl<'a> Layout<'a> {
             shapes,
             weights: Weights::default(),
             owner: vec![NONE; must.len()],
+            shade: vec![NONE; must.len()],
             pieces: Vec::new(),
             groups: Vec::new(),
             uf: UnionFind::default(),
@@ -401,8 +407,15 @@ impl<'a> Layout<'a> {
     pub(super) fn free(&self, c: Cell) -> bool {
         self.must.in_bounds(c)
             && self.owner[self.must.index(c)] == NONE
+            && self.shade[self.must.index(c)] == NONE
             && !self.kept_empty(c)
             && (self.refused.is_empty() || !self.refused.contains(&c))
+    }
+
+    /// Whether `c` is in a slope's box, over its face, or refused to
+    /// every piece (see [`Layout::refused`]): no piece may take it.
+    pub(super) fn shaded(&self, c: Cell) -> bool {
+        self.shade[self.must.index(c)] != NONE || self.refused.contains(&c)
     }
 
     /// Whether `c` must stay empty (the inside of a hollow build).
@@ -544,6 +557,7 @@ impl<'a> Layout<'a> {
                     self.owner[i] = NONE;
                 }
             }
+            self.shade_open(&body, id as u32, false);
         }
         self.pieces.truncate(saved.0);
         self.groups.truncate(saved.1);
@@ -1003,6 +1017,7 @@ impl<'a> Layout<'a> {
             debug_assert_eq!(self.owner[i], NONE, "a piece laid over another at {q:?}");
             self.owner[i] = id;
         }
+        self.shade_open(&body, id, true);
         self.pieces.push(Laid {
             placement,
             body,
@@ -1041,6 +1056,27 @@ impl<'a> Layout<'a> {
                 self.owner[i] = NONE;
             }
         }
+        self.shade_open(&body, id, false);
+    }
+
+    /// Marks (`on`) or clears the open cells of piece `id`'s `body`, the
+    /// cells of its box it does not fill.
+    fn shade_open(&mut self, body: &Body, id: u32, on: bool) {
+        if body.is_box() {
+            return;
+        }
+        for q in body.bbox.cells().filter(|&q| !body.contains(q)) {
+            if !self.must.in_bounds(q) {
+                continue;
+            }
+            let i = self.must.index(q);
+            if on {
+                debug_assert_eq!(self.shade[i], NONE, "a slope's box over another's at {q:?}");
+                self.shade[i] = id;
+            } else if self.shade[i] == id {
+                self.shade[i] = NONE;
+            }
+        }
     }
 
     /// Puts back piece `id`, taken out by [`Layout::remove`]: its cells
@@ -1057,6 +1093,7 @@ impl<'a> Layout<'a> {
             );
             self.owner[i] = id;
         }
+        self.shade_open(&body, id, true);
     }
 
     /// Whether the rules join `a` and `b`, pieces in place where one rests

@@ -672,7 +672,7 @@ impl Layout<'_> {
 
     /// A cell in the grid, owned by no piece and not kept empty.
     fn free_cell(&self, c: Cell) -> bool {
-        self.must.in_bounds(c) && self.owner_of(c).is_none() && !self.kept_empty(c)
+        self.free(c)
     }
 
     /// Takes piece `id` out and lays, in its place, slopes of `kind` along
