@@ -397,6 +397,32 @@ mod tests {
     }
 
     #[test]
+    fn a_corner_slopes_origin_is_on_its_full_cell() {
+        // 3045's origin is its one stud, 3676's the centre of the cell it
+        // is held by from below: the full cell of the grid body, turned
+        // any way.
+        for (id, up) in [("3045", true), ("3676", false)] {
+            let part = PartKind::from_id(id).unwrap();
+            for rot in Rot::ALL {
+                let p = Placement {
+                    part,
+                    origin: Cell::new(4, 7, 2),
+                    rot,
+                };
+                let [x, _, z] = placement_position(&p, 12);
+                let body = p.body(12);
+                let full = if up { body.studs } else { body.tubes };
+                assert_eq!((full.sx, full.sy), (1, 1), "{id} {rot:?}");
+                assert_eq!(
+                    ((x - 10) / 20, (z - 10) / 20),
+                    (i64::from(full.min.x), i64::from(full.min.y)),
+                    "{id} {rot:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn a_marked_corner_goes_where_rot_apply_sends_it() {
         // The 2x4's corner at local (+40, 0, -20): grid offset (2, -1) from
         // the centre. Turned R90 it must sit at grid offset (1, 2).
