@@ -408,16 +408,36 @@ fn nothing_is_left_out_over_a_slope_within_a_course() {
 }
 
 #[test]
-fn no_piece_takes_the_cells_over_a_slopes_face() {
-    // With plates and slopes (layers a plate high) a plate laid over a
-    // slope's front row could take a cell of the slope's box, over its
-    // face: the two pieces would meet, and the build failed verification
-    // (the mug at 32 studs: pieces #266 and #307 overlapped).
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/mug.obj");
-    let rules = default_rules();
+fn with_plates_bricks_lie_on_courses() {
+    // With plates the layers are a plate high. Bricks laid wherever the
+    // shape's edge fell stood in columns of their own height, a plate or
+    // two apart, their seams running straight up (the pebble: 87% of its
+    // seams continued, 8.3 voxels a piece, 23% 1x1s); on brick courses,
+    // with plates over and under them, they bond (23%, 18.5, 4%).
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pebble.obj");
+    std::fs::write(&path, ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
+    let rules = default_rules()
+        .restricted(|p| p.spec().family() != Family::Slope)
+        .unwrap();
     assert_eq!(rules.layer_ldu(), 8);
-    for studs in [32, 36] {
-        let asm = build_by(&path, studs, &rules);
-        assert!(slopes(&asm) > 0, "{studs} studs");
-    }
+    let asm = build_by(&path, 24, &rules);
+    let bricks: Vec<i32> = asm
+        .pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().family() == Family::Brick)
+        .map(|p| p.placement.origin.z)
+        .collect();
+    let on_course = bricks.iter().filter(|z| z.rem_euclid(3) == 0).count();
+    let seams = brickwright::assembly::metrics::seams(&asm);
+    eprintln!(
+        "pebble with plates: {} pieces, {} bricks, {on_course} on courses; {} of {} seams continued",
+        asm.pieces.len(),
+        bricks.len(),
+        seams.continued,
+        seams.seams
+    );
+    assert!(bricks.len() > 20);
+    assert!(on_course as f64 >= 0.9 * bricks.len() as f64);
+    assert!(seams.fraction < 0.3, "{seams:?}");
 }
