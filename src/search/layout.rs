@@ -25,7 +25,7 @@
 //! - **courses**: a long piece laid along the course's direction earns
 //!   (directions alternate course to course, so walls and solids bond);
 //!   with plates, a piece as tall as a brick laid off a brick course costs
-//!   as much as thirty voxels covered earn (bricks on courses, plates
+//!   as much as twelve voxels covered earn (bricks on courses, plates
 //!   following the shape over and under them);
 //! - **no small leftovers**: a free voxel the piece would leave with no free
 //!   neighbour (only a 1x1 could cover it) costs, and so does a 1x1.
@@ -104,7 +104,7 @@ impl Default for Weights {
             along: 0.4,
             isolated: 3.0,
             single: 2.5,
-            off_course: 30.0,
+            off_course: 12.0,
             noise: 0.05,
         }
     }
@@ -884,9 +884,12 @@ impl<'a> Layout<'a> {
         // under the courses: laid a plate or two off the course wherever
         // the shape's edge fell, bricks stood in columns of their own
         // height (the bunny at 48 studs: 81% of seams continued, 6,056
-        // pieces). A thin shell (hollow) may need one off its course, so
-        // it costs rather than being refused: refused, the fandisk's shell
-        // at 48 studs had 63% 1x1s.
+        // pieces; 25% and 2,823 now). A thin part may need one off its
+        // course, so it costs rather than being refused, and not much:
+        // refused, the fandisk's hollow shell at 48 studs had 63% 1x1s
+        // (33% now, 37% before); at a cost of 20 or more, the glider's
+        // wings at 24 studs (`--slopes --plates`, seed 3) were left out,
+        // no piece joining them to the fuselage.
         let off_course = self.course > self.phase
             && shape.body.bbox.sz >= self.course
             && origin.z.rem_euclid(self.course) != 0;

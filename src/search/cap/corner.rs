@@ -19,7 +19,7 @@
 
 use super::{Budget, Part, Swap};
 use crate::assembly::Placement;
-use crate::catalog::Shape;
+use crate::catalog::{PartKind, Shape};
 use crate::geom::{Cell, CellBox, Rot};
 use crate::search::layout::Layout;
 
@@ -71,7 +71,7 @@ impl Layout<'_> {
         &mut self,
         id: u32,
         kind: Shape,
-        part: crate::catalog::PartKind,
+        part: PartKind,
         budget: &mut Budget,
     ) -> Option<usize> {
         let p = self.pieces[id as usize];
@@ -123,7 +123,7 @@ impl Layout<'_> {
         &self,
         b: &CellBox,
         kind: Shape,
-        part: crate::catalog::PartKind,
+        part: PartKind,
         c: Cell,
         front: (i32, i32),
         e: (i32, i32),
