@@ -199,11 +199,14 @@ impl Layout<'_> {
                 ] {
                     if let Some(w) = self.owner_of(n) {
                         let wb = self.pieces[w as usize].body;
+                        // The other piece may be a slope: a long slope laid
+                        // where a thin wing meets the fuselage may be all
+                        // the wing touches (the glider at 24 studs,
+                        // `--slopes --plates`: both wings were left out).
                         if roots[w as usize] != root
                             && !others.contains(&w)
                             && wb.bbox.min.z < hb.bbox.min.z + hb.bbox.sz
                             && hb.bbox.min.z < wb.bbox.min.z + wb.bbox.sz
-                            && wb.is_box()
                         {
                             others.push(w);
                         }
