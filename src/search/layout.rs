@@ -414,15 +414,15 @@ impl<'a> Layout<'a> {
     pub(super) fn free(&self, c: Cell) -> bool {
         self.must.in_bounds(c)
             && self.owner[self.must.index(c)] == NONE
-            && self.shade[self.must.index(c)] == NONE
             && !self.kept_empty(c)
-            && (self.refused.is_empty() || !self.refused.contains(&c))
+            && !self.shaded(c)
     }
 
     /// Whether `c` is in a slope's box, over its face, or refused to
     /// every piece (see [`Layout::refused`]): no piece may take it.
     pub(super) fn shaded(&self, c: Cell) -> bool {
-        self.shade[self.must.index(c)] != NONE || self.refused.contains(&c)
+        self.shade[self.must.index(c)] != NONE
+            || (!self.refused.is_empty() && self.refused.contains(&c))
     }
 
     /// Whether `c` must stay empty (the inside of a hollow build).
@@ -673,7 +673,7 @@ impl<'a> Layout<'a> {
         let mut best: Option<Candidate> = None;
         for s in 0..self.shapes.len() {
             // Corner slopes are the cap pass's, laid where two rows of
-            // slopes meet (see `cap::corners`).
+            // slopes meet (see `cap::corner`).
             if self.shapes[s].part.spec().shape.is_corner() {
                 continue;
             }
@@ -818,15 +818,20 @@ impl<'a> Layout<'a> {
             return true;
         };
         // A corner slope's faces fall two ways: the mesh slants either.
-        let grids: Vec<_> = spec
-            .faces(p.rot)
-            .filter_map(|f| slant.facing(f, up))
-            .collect();
-        if grids.is_empty() {
+        let mut facing = spec.faces(p.rot).filter_map(|f| slant.facing(f, up));
+        let grids = [facing.next(), facing.next()];
+        if grids[0].is_none() {
             return true;
         }
         let inward = if up { -1 } else { 1 };
-        open().any(|q| (0..=depth).any(|k| grids.iter().any(|g| g.get(q.offset(0, 0, inward * k)))))
+        open().any(|q| {
+            (0..=depth).any(|k| {
+                grids
+                    .iter()
+                    .flatten()
+                    .any(|g| g.get(q.offset(0, 0, inward * k)))
+            })
+        })
     }
 
     /// Whether a piece's box lies right under the box `b` somewhere (a

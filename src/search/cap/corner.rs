@@ -140,7 +140,7 @@ impl Layout<'_> {
         let dz = if up { -1 } else { 1 };
         let open = past.iter().all(|q| {
             let q = Cell::new(q.x, q.y, z);
-            self.free_cell(q) && self.clear_column(q, -dz)
+            self.free(q) && self.clear_column(q, -dz)
         });
         let rests = past
             .iter()

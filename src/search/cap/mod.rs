@@ -621,16 +621,12 @@ impl Layout<'_> {
             // Front row at the brick's bottom layer, open above,
             // resting on a piece.
             let f = Cell::new(n.x, n.y, b.min.z);
-            self.free_cell(f)
-                && self.clear_column(f, 1)
-                && self.owner_of(f.offset(0, 0, -1)).is_some()
+            self.free(f) && self.clear_column(f, 1) && self.owner_of(f.offset(0, 0, -1)).is_some()
         } else {
             // Front row at the brick's top layer, open below,
             // holding a piece above.
             let f = Cell::new(n.x, n.y, b.min.z + b.sz - 1);
-            self.free_cell(f)
-                && self.clear_column(f, -1)
-                && self.owner_of(f.offset(0, 0, 1)).is_some()
+            self.free(f) && self.clear_column(f, -1) && self.owner_of(f.offset(0, 0, 1)).is_some()
         }
     }
 
@@ -662,17 +658,12 @@ impl Layout<'_> {
     fn clear_column(&self, f: Cell, dz: i32) -> bool {
         let mut q = f.offset(0, 0, dz);
         while self.must.in_bounds(q) {
-            if !self.free_cell(q) || self.must.get(q) {
+            if !self.free(q) || self.must.get(q) {
                 return false;
             }
             q = q.offset(0, 0, dz);
         }
         true
-    }
-
-    /// A cell in the grid, owned by no piece and not kept empty.
-    fn free_cell(&self, c: Cell) -> bool {
-        self.free(c)
     }
 
     /// Takes piece `id` out and lays, in its place, slopes of `kind` along
