@@ -17,7 +17,10 @@
 //!    rests on nothing the rules join is joined to another by growing one of
 //!    its pieces or laying a piece across, with the fewest cells outside;
 //!    `merge` then makes neighbours whose union is a piece of the alphabet
-//!    one piece: never a seam more, always a piece fewer; and `cap`, where
+//!    one piece: never a seam more, always a piece fewer; a brick's side
+//!    row outside the model with nothing over it is trimmed off
+//!    (`cap::trim`: no step on a roof with a row standing up); and
+//!    `cap`, where
 //!    the alphabet has slopes, swaps the row of a brick that stands a step
 //!    above its neighbours (below, underneath) for slopes facing down the
 //!    step, so a slanted roof is capped rather than a staircase;
@@ -426,11 +429,10 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
-    let mut swaps = if opts.cap_stairs {
-        layout.cap_stairs()
-    } else {
-        Vec::new()
-    };
+    let mut swaps = layout.trim_outside();
+    if opts.cap_stairs {
+        swaps.extend(layout.cap_stairs());
+    }
     // Nor may they split the build: a swap keeps its own joints, but two
     // swaps side by side can take both ends of the one piece that joined
     // two parts.

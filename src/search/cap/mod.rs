@@ -51,6 +51,7 @@
 
 mod corner;
 mod line;
+mod trim;
 
 use super::layout::{Layout, Reach};
 use crate::assembly::{stairs, Assembly, Placement};
