@@ -31,14 +31,15 @@ impl Layout<'_> {
     /// slopes), to be undone with the others.
     pub(crate) fn trim_outside(&mut self) -> Vec<Swap> {
         let mut swaps = Vec::new();
+        let mut undone = false;
         // Pieces laid here are looked at too: a piece may lose a row on
         // two sides.
         let mut id = 0;
         while id < self.pieces.len() as u32 {
-            swaps.extend(self.trim_piece(id));
+            swaps.extend(self.trim_piece(id, &mut undone));
             id += 1;
         }
-        if !swaps.is_empty() {
+        if !swaps.is_empty() || undone {
             self.rebuild_bodies();
         }
         swaps
@@ -46,8 +47,9 @@ impl Layout<'_> {
 
     /// Trims a side row of piece `id` that lies wholly outside the model,
     /// if what is left fits and keeps the joints; the swaps made (none, or
-    /// the trim and a merge).
-    fn trim_piece(&mut self, id: u32) -> Vec<Swap> {
+    /// the trim and a merge). `undone` is set when a trim laid a piece and
+    /// took it out again (the bodies are to be made again).
+    fn trim_piece(&mut self, id: u32, undone: &mut bool) -> Vec<Swap> {
         let p = self.pieces[id as usize];
         if p.gone || p.group.is_some() || p.placement.part.spec().shape != Shape::Rect {
             return Vec::new();
@@ -88,16 +90,19 @@ impl Layout<'_> {
             for (placement, body) in new {
                 self.place(placement, body, None);
             }
-            let mut swaps = vec![Swap {
+            let trim = Swap {
                 taken: vec![id],
                 laid: first..self.pieces.len() as u32,
                 slopes: 0,
-            }];
+            };
+            let mut swaps = vec![trim];
             if single {
                 match self.merge_single(first, &rest) {
                     Some(merge) => swaps.push(merge),
                     None => {
-                        self.uncap(&swaps);
+                        self.remove(first);
+                        self.restore(id);
+                        *undone = true;
                         continue;
                     }
                 }
