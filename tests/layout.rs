@@ -32,7 +32,11 @@ fn build_fixture(name: &str, studs: u32, rules: &RuleSet, seed: u64) -> Built {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures")
         .join(name);
-    let mesh = brickwright::mesh::load(&path).unwrap();
+    build_mesh(&path, studs, rules, seed)
+}
+
+fn build_mesh(path: &std::path::Path, studs: u32, rules: &RuleSet, seed: u64) -> Built {
+    let mesh = brickwright::mesh::load(path).unwrap();
     let vopts = VoxelizeOptions::default()
         .with_sizing(Sizing::Studs(studs))
         .with_layer_ldu(rules.layer_ldu());
@@ -167,6 +171,77 @@ fn a_diagonal_rod_one_voxel_thick_is_built_whole() {
     let b = checked(g, out, &r);
     assert!(b.out.repairs.extra_cells > 0);
     assert_eq!(b.out.repairs.joined_islands, 0);
+}
+
+/// A pillar with a thin fin running out from it at 45°, its underside
+/// rising toward the far end, as OBJ text (y up): like a rabbit's ear, the
+/// fin is one voxel across and its far columns start higher and higher,
+/// each touching the one before only along an edge.
+fn pillar_with_fin(thick: f64, rise: f64) -> String {
+    let mut verts: Vec<(f64, f64, f64)> = Vec::new();
+    let mut obj = String::new();
+    let mut add = |bottom: [(f64, f64, f64); 4], top: f64| {
+        let b = verts.len() + 1;
+        verts.extend(bottom);
+        verts.extend(bottom.map(|(x, y, _)| (x, y, top)));
+        for [p, q, r] in [
+            [0, 1, 2],
+            [0, 2, 3],
+            [4, 6, 5],
+            [4, 7, 6],
+            [0, 4, 5],
+            [0, 5, 1],
+            [1, 5, 6],
+            [1, 6, 2],
+            [2, 6, 7],
+            [2, 7, 3],
+            [3, 7, 4],
+            [3, 4, 0],
+        ] {
+            obj += &format!("f {} {} {}\n", b + p, b + q, b + r);
+        }
+    };
+    add(
+        [
+            (0.0, 0.0, 0.0),
+            (2.0, 0.0, 0.0),
+            (2.0, 2.0, 0.0),
+            (0.0, 2.0, 0.0),
+        ],
+        8.0,
+    );
+    let d = std::f64::consts::FRAC_1_SQRT_2;
+    let (len, t) = (6.0, thick / 2.0);
+    let (near0, near1) = ((1.6 - d * t, 1.6 + d * t), (1.6 + d * t, 1.6 - d * t));
+    add(
+        [
+            (near0.0, near0.1, 4.0),
+            (near1.0, near1.1, 4.0),
+            (near1.0 + d * len, near1.1 + d * len, 4.0 + rise),
+            (near0.0 + d * len, near0.1 + d * len, 4.0 + rise),
+        ],
+        8.0,
+    );
+    let v: String = verts
+        .iter()
+        .map(|(x, y, z)| format!("v {x} {z} {y}\n"))
+        .collect();
+    v + &obj
+}
+
+/// The fin's far end meets the rest only at edges: it is built whole,
+/// the pieces where it meets laid again with one across the corner (the
+/// layout left 52-155 of its voxels out at 16-28 studs; the bunny's ear
+/// tip at 32 studs with plates, 3).
+#[test]
+fn a_thin_fin_touching_at_its_edges_is_built_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    for (thick, studs) in [(0.5, 16), (0.3, 20), (0.3, 28)] {
+        let path = dir.path().join(format!("fin-{thick}.obj"));
+        std::fs::write(&path, pillar_with_fin(thick, 3.0)).unwrap();
+        // `checked` asserts every voxel built.
+        build_mesh(&path, studs, &rules(false, false), 1);
+    }
 }
 
 /// A standing ring one voxel thick: its sides climb diagonally, its top

@@ -6,17 +6,28 @@
 //! backtracking, [`Layout::join`] repairs locally: a piece of the loose body
 //! grows into a bigger piece that reaches a piece of another body above or
 //! below it (filling empty cells beside it), or a new piece is laid on top
-//! of it or under it, across to another body. Each repair takes the fewest
-//! cells outside the model. A body nothing can join is left out, and the
-//! report says where.
+//! of it or under it, across to another body, or it and a piece beside it
+//! are laid again with a piece across the two. Each repair takes the fewest
+//! cells outside the model. Last, a body that meets the rest only at a
+//! corner (a thin fin's far columns, each touching the one before along an
+//! edge) has the two pieces there laid again with one across the corner,
+//! over cells the surface passes through. A body nothing can join is left
+//! out, and the report says where.
 
-use super::layout::{Layout, PieceShape};
+use super::layout::{Layout, PieceShape, Reach};
 use crate::assembly::Placement;
 use crate::catalog::Shape;
 use crate::geom::{Body, Cell};
 
 /// Rounds of repairs before what is still apart is left out.
 const ROUNDS: usize = 8;
+
+/// How two pieces of a retile meet: side by side, or only at a corner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Meet {
+    Side,
+    Corner,
+}
 
 /// A repair: the piece to take out (for a grown one), and the piece to lay.
 struct Fix {
@@ -71,7 +82,31 @@ impl Layout<'_> {
                     self.place(fix.placement, fix.body, None);
                     self.stats.joins += 1;
                     progress = true;
-                } else if self.retile_across(body, root, rng) {
+                } else if self.retile_across(body, root, rng, Meet::Side) {
+                    self.stats.joins += 1;
+                    progress = true;
+                }
+            }
+            self.rebuild_bodies();
+            if !progress {
+                break;
+            }
+        }
+        // Last, a body that meets the rest only at a corner (a thin ear's
+        // tip one stud across, touching the ear along an edge): the two
+        // pieces there are laid again with one across the corner, over
+        // cells the surface passes through.
+        for _ in 0..ROUNDS {
+            let bodies = self.bodies();
+            if bodies.len() <= 1 {
+                break;
+            }
+            let mut progress = false;
+            for body in bodies[1..].iter().rev() {
+                let root = self.uf.find(body[0]);
+                if self.uf.find(bodies[0][0]) != root
+                    && self.retile_across(body, root, rng, Meet::Corner)
+                {
                     self.stats.joins += 1;
                     progress = true;
                 }
@@ -176,7 +211,13 @@ impl Layout<'_> {
     /// two first, the rest of their voxels as the layout would: for a body
     /// that meets the rest side by side (a handle against a wall). Kept
     /// only if it joins the body to another; undone otherwise.
-    fn retile_across(&mut self, body: &[u32], root: u32, rng: &mut impl rand::Rng) -> bool {
+    fn retile_across(
+        &mut self,
+        body: &[u32],
+        root: u32,
+        rng: &mut impl rand::Rng,
+        meet: Meet,
+    ) -> bool {
         let roots: Vec<u32> = (0..self.pieces.len() as u32)
             .map(|i| self.uf.find(i))
             .collect();
@@ -190,13 +231,12 @@ impl Layout<'_> {
                 continue;
             }
             let mut others: Vec<u32> = Vec::new();
+            let near: &[(i32, i32)] = match meet {
+                Meet::Side => &[(1, 0), (-1, 0), (0, 1), (0, -1)],
+                Meet::Corner => &[(1, 1), (1, -1), (-1, 1), (-1, -1)],
+            };
             for q in hb.cells() {
-                for n in [
-                    q.offset(1, 0, 0),
-                    q.offset(-1, 0, 0),
-                    q.offset(0, 1, 0),
-                    q.offset(0, -1, 0),
-                ] {
+                for n in near.iter().map(|d| q.offset(d.0, d.1, 0)) {
                     if let Some(w) = self.owner_of(n) {
                         let wb = self.pieces[w as usize].body;
                         // The other piece may be a slope: a long slope laid
@@ -218,7 +258,7 @@ impl Layout<'_> {
                 if tries > 64 {
                     return false;
                 }
-                if self.retile_pair((h, w), (root, &roots), rng) {
+                if self.retile_pair((h, w), (root, &roots), rng, meet) {
                     return true;
                 }
             }
@@ -233,6 +273,7 @@ impl Layout<'_> {
         (h, w): (u32, u32),
         (root, roots): (u32, &[u32]),
         rng: &mut impl rand::Rng,
+        meet: Meet,
     ) -> bool {
         let (hp, wp) = (self.pieces[h as usize], self.pieces[w as usize]);
         let cells: Vec<Cell> = hp
@@ -245,8 +286,11 @@ impl Layout<'_> {
         let extra_before = self.repairs.extra_cells;
         self.remove(h);
         self.remove(w);
-        let ok = match self.across(&hp.body, &wp.body) {
+        let ok = match self.across(&hp.body, &wp.body, meet) {
             Some((p, b)) => {
+                // Cells outside the model: only where the two meet at a
+                // corner.
+                self.repairs.extra_cells += b.cells().filter(|&q| !self.must.get(q)).count();
                 self.place(p, b, None);
                 for &c in &cells {
                     if self.owner_of(c).is_none() {
@@ -290,8 +334,10 @@ impl Layout<'_> {
     }
 
     /// The biggest brick (or plate) over the model's free voxels in the
-    /// layers `a` and `b` share that reaches into the boxes of both.
-    fn across(&self, a: &Body, b: &Body) -> Option<(Placement, Body)> {
+    /// layers `a` and `b` share that reaches into the boxes of both; where
+    /// they meet at a corner, over the cells the surface passes through
+    /// too, the fewest of those first.
+    fn across(&self, a: &Body, b: &Body, meet: Meet) -> Option<(Placement, Body)> {
         let mut best: Option<(i32, Placement, Body)> = None;
         let ab = a.bbox;
         let lo = ab.min.z.max(b.bbox.min.z);
@@ -307,13 +353,25 @@ impl Layout<'_> {
                     for oy in ab.min.y - fy + 1..ab.min.y + ab.sy {
                         let origin = Cell::new(ox, oy, oz);
                         let body = shape.body_at(origin);
-                        if !body.bbox.intersects(&ab)
-                            || !body.bbox.intersects(&b.bbox)
-                            || !body.cells().all(|q| self.must.get(q) && self.free(q))
-                        {
+                        if !body.bbox.intersects(&ab) || !body.bbox.intersects(&b.bbox) {
                             continue;
                         }
-                        let v = body.volume();
+                        let v = match meet {
+                            Meet::Side
+                                if body.cells().all(|q| self.must.get(q) && self.free(q)) =>
+                            {
+                                body.volume()
+                            }
+                            Meet::Corner => {
+                                let placement = Placement::new(shape.part, origin, shape.rot);
+                                match self.fits(&placement, &body, Reach::Near) {
+                                    // Fewest cells outside, then the biggest.
+                                    Some((inside, near, 0)) => inside as i32 - 1000 * near as i32,
+                                    _ => continue,
+                                }
+                            }
+                            Meet::Side => continue,
+                        };
                         if best.as_ref().is_none_or(|x| v > x.0) {
                             best = Some((v, Placement::new(shape.part, origin, shape.rot), body));
                         }
