@@ -62,58 +62,13 @@ impl Layout<'_> {
     /// out the bodies nothing joins.
     pub fn join(&mut self, rng: &mut impl rand::Rng) {
         self.rebuild_bodies();
-        for _ in 0..ROUNDS {
-            let bodies = self.bodies();
-            if bodies.len() <= 1 {
+        // Side by side first; last, a body that meets the rest only at a
+        // corner (a thin ear's tip one stud across, touching the ear along
+        // an edge): the two pieces there are laid again with one across
+        // the corner, over cells the surface passes through.
+        for meet in [Meet::Side, Meet::Corner] {
+            if self.join_rounds(rng, meet) {
                 return;
-            }
-            let mut progress = false;
-            // Smallest loose body first: it has the fewest ways out.
-            for body in bodies[1..].iter().rev() {
-                let root = self.uf.find(body[0]);
-                if self.uf.find(bodies[0][0]) == root {
-                    continue;
-                }
-                if let Some(fix) = self.find_fix(body, root) {
-                    if let Some(old) = fix.replaces {
-                        self.remove(old);
-                    }
-                    self.repairs.extra_cells += fix.extra;
-                    self.place(fix.placement, fix.body, None);
-                    self.stats.joins += 1;
-                    progress = true;
-                } else if self.retile_across(body, root, rng, Meet::Side) {
-                    self.stats.joins += 1;
-                    progress = true;
-                }
-            }
-            self.rebuild_bodies();
-            if !progress {
-                break;
-            }
-        }
-        // Last, a body that meets the rest only at a corner (a thin ear's
-        // tip one stud across, touching the ear along an edge): the two
-        // pieces there are laid again with one across the corner, over
-        // cells the surface passes through.
-        for _ in 0..ROUNDS {
-            let bodies = self.bodies();
-            if bodies.len() <= 1 {
-                break;
-            }
-            let mut progress = false;
-            for body in bodies[1..].iter().rev() {
-                let root = self.uf.find(body[0]);
-                if self.uf.find(bodies[0][0]) != root
-                    && self.retile_across(body, root, rng, Meet::Corner)
-                {
-                    self.stats.joins += 1;
-                    progress = true;
-                }
-            }
-            self.rebuild_bodies();
-            if !progress {
-                break;
             }
         }
         let bodies = self.bodies();
@@ -132,6 +87,46 @@ impl Layout<'_> {
             }
         }
         self.rebuild_bodies();
+    }
+
+    /// Rounds of repairs of the bodies apart, those `meet` allows, until
+    /// one makes no progress; whether the pieces are one body.
+    fn join_rounds(&mut self, rng: &mut impl rand::Rng, meet: Meet) -> bool {
+        for _ in 0..ROUNDS {
+            let bodies = self.bodies();
+            if bodies.len() <= 1 {
+                return true;
+            }
+            let mut progress = false;
+            // Smallest loose body first: it has the fewest ways out.
+            for body in bodies[1..].iter().rev() {
+                let root = self.uf.find(body[0]);
+                if self.uf.find(bodies[0][0]) == root {
+                    continue;
+                }
+                let fix = match meet {
+                    Meet::Side => self.find_fix(body, root),
+                    Meet::Corner => None,
+                };
+                if let Some(fix) = fix {
+                    if let Some(old) = fix.replaces {
+                        self.remove(old);
+                    }
+                    self.repairs.extra_cells += fix.extra;
+                    self.place(fix.placement, fix.body, None);
+                    self.stats.joins += 1;
+                    progress = true;
+                } else if self.retile_across(body, root, rng, meet) {
+                    self.stats.joins += 1;
+                    progress = true;
+                }
+            }
+            self.rebuild_bodies();
+            if !progress {
+                break;
+            }
+        }
+        self.bodies().len() <= 1
     }
 
     /// The repair that joins the body `body` (root `root`) to another with
