@@ -429,6 +429,8 @@ pub fn build_guided(
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);
     layout.merge();
+    // The cells outside the model as laid, for when the swaps are undone.
+    let extra = layout.repairs.extra_cells;
     let mut swaps = layout.trim_outside();
     if opts.cap_stairs {
         swaps.extend(layout.cap_stairs());
@@ -438,6 +440,7 @@ pub fn build_guided(
     // two parts.
     if !swaps.is_empty() && layout.bodies().len() > 1 {
         layout.uncap(&swaps);
+        layout.repairs.extra_cells = extra;
         swaps.clear();
     }
     let (mut order, mut unreached) = derive(&layout);
@@ -446,6 +449,7 @@ pub fn build_guided(
     // piece cannot be put in place or reached with them, they are undone.
     if !swaps.is_empty() && (!unreached.is_empty() || !blocked.is_empty()) {
         layout.uncap(&swaps);
+        layout.repairs.extra_cells = extra;
         (order, unreached) = derive(&layout);
         blocked = unplaceable(&order, rules.layer_ldu());
     } else {
