@@ -333,7 +333,9 @@ impl Layout<'_> {
     /// they meet at a corner, over the cells the surface passes through
     /// too, the fewest of those first.
     fn across(&self, a: &Body, b: &Body, meet: Meet) -> Option<(Placement, Body)> {
-        let mut best: Option<(i32, Placement, Body)> = None;
+        // Ranked by (fewest cells outside, most cells): all inside side by
+        // side.
+        let mut best: Option<((i32, i32), Placement, Body)> = None;
         let ab = a.bbox;
         let lo = ab.min.z.max(b.bbox.min.z);
         let hi = (ab.min.z + ab.sz).min(b.bbox.min.z + b.bbox.sz);
@@ -355,13 +357,12 @@ impl Layout<'_> {
                             Meet::Side
                                 if body.cells().all(|q| self.must.get(q) && self.free(q)) =>
                             {
-                                body.volume()
+                                (0, body.volume())
                             }
                             Meet::Corner => {
                                 let placement = Placement::new(shape.part, origin, shape.rot);
                                 match self.fits(&placement, &body, Reach::Near) {
-                                    // Fewest cells outside, then the biggest.
-                                    Some((inside, near, 0)) => inside as i32 - 1000 * near as i32,
+                                    Some((inside, near, 0)) => (-(near as i32), inside as i32),
                                     _ => continue,
                                 }
                             }
