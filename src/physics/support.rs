@@ -9,7 +9,10 @@
 //!
 //! 1. every cell under a piece's bottom that is empty all the way down to
 //!    the ground (or to the top of a piece built before it) is a
-//!    **candidate column**;
+//!    **candidate column**; under a piece hung from one built before it
+//!    (pressed on from below, as a table top's first course between its
+//!    legs), only if the piece moves to stand on the column, first in the
+//!    step of the piece it hung from, and at a higher price;
 //! 2. one linear program (`model::solve_propped`) lets every candidate push its
 //!    piece up, at a price per unit of force, while no stud joint may use
 //!    more than [`TARGET`] of its clutch: the candidates it leans on are
@@ -61,6 +64,10 @@ const ROUNDS: usize = 12;
 const PROP_COST: f64 = 10.0;
 const PROP_COST_PER_LAYER: f64 = 0.5;
 
+/// More per unit of prop force under a hung piece, which then moves (see
+/// [`Candidate::before`]): a column where no piece moves is taken first.
+const MOVE_COST: f64 = 30.0;
+
 /// A prop weaker than this share of the strongest one in a round is left
 /// for a later round.
 const KEEP_SHARE: f64 = 0.25;
@@ -103,9 +110,19 @@ struct Candidate {
     foot: (i32, i32, i32, i32),
     bottom: i32,
     lands_on: Option<usize>,
+    /// The piece the column goes in before: the piece held, or the piece
+    /// built first over it when it was hung under that one (it then moves
+    /// to stand on the column, before that piece, see [`insert`]).
+    before: usize,
 }
 
 impl Candidate {
+    /// Whether the piece held is hung under a piece built before it, and
+    /// moves to stand on the column instead.
+    fn moves(&self) -> bool {
+        self.before != self.piece
+    }
+
     /// Whether the column's footprint covers stud `(x, y)`.
     fn covers(&self, x: i32, y: i32) -> bool {
         let (x0, y0, sx, sy) = self.foot;
@@ -361,16 +378,23 @@ fn candidates(
         .max()
         .unwrap_or(0);
     // A piece hung under one built before it is pressed on from below: a
-    // column under it would bar the way.
-    let hung: Vec<bool> = bodies
+    // column under it would bar the way, unless the piece moves to stand
+    // on the column before the first piece built over it (its hanger).
+    let owned = &owner;
+    let hanger: Vec<Option<usize>> = bodies
         .iter()
         .enumerate()
         .map(|(i, b)| {
             let z = b.bbox.min.z;
-            b.bbox.cells().filter(|c| c.z == z).any(|c| {
-                (b.bbox.max_excl().z..top)
-                    .any(|zz| owner.get(&Cell::new(c.x, c.y, zz)).is_some_and(|&j| j < i))
-            })
+            b.bbox
+                .cells()
+                .filter(|c| c.z == z)
+                .flat_map(|c| {
+                    (b.bbox.max_excl().z..top)
+                        .filter_map(move |zz| owned.get(&Cell::new(c.x, c.y, zz)).copied())
+                })
+                .filter(|&j| j < i)
+                .min()
         })
         .collect();
     // Columns stay within the model's footprint box (and so within its
@@ -391,9 +415,13 @@ fn candidates(
     let mut out = Vec::new();
     for (i, b) in bodies.iter().enumerate().take(end) {
         let z = b.bbox.min.z;
-        if z == ground || hung[i] {
+        if z == ground {
             continue;
         }
+        // The piece the column goes in before, and the first piece of its
+        // step: the column lands on a piece built before that.
+        let before = hanger[i].unwrap_or(i);
+        let start = step_start[before];
         for c in b.tubes.cells() {
             let mut zb = z - 1;
             while zb >= ground && free(c.x, c.y, zb) {
@@ -409,8 +437,7 @@ fn candidates(
                     return Some(None);
                 }
                 let q = *owner.get(&Cell::new(x, y, zb))?;
-                (q < step_start[i] && bodies[q].studs.contains(Cell::new(x, y, zb)))
-                    .then_some(Some(q))
+                (q < start && bodies[q].studs.contains(Cell::new(x, y, zb))).then_some(Some(q))
             };
             let Some(lands_on) = base(c.x, c.y) else {
                 continue;
@@ -425,9 +452,9 @@ fn candidates(
                         (x0..x0 + sx).all(|x| {
                             (zb + 1..z).all(|zz| free(x, y, zz))
                                 && base(x, y).is_some_and(|q| q.is_some() == lands_on.is_some())
-                                && owner
-                                    .get(&Cell::new(x, y, z))
-                                    .is_none_or(|&j| j == i || (j >= step_start[i] && !hung[j]))
+                                && owner.get(&Cell::new(x, y, z)).is_none_or(|&j| {
+                                    j == i || (j >= step_start[i] && hanger[j].is_none())
+                                })
                         })
                     })
             };
@@ -449,6 +476,7 @@ fn candidates(
                 foot,
                 bottom: zb + 1,
                 lands_on,
+                before,
             });
         }
     }
@@ -485,7 +513,8 @@ fn plan(
             at: (f64::from(c.x) + 0.5, f64::from(c.y) + 0.5),
             lands_on: c.lands_on,
             cost: PROP_COST
-                + PROP_COST_PER_LAYER * f64::from(bodies[c.piece].bbox.min.z - c.bottom),
+                + PROP_COST_PER_LAYER * f64::from(bodies[c.piece].bbox.min.z - c.bottom)
+                + if c.moves() { MOVE_COST } else { 0.0 },
         })
         .collect();
     let pieces: Vec<usize> = (0..end).collect();
@@ -546,10 +575,16 @@ fn insert(
     let mut by_step: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
     for (k, c) in chosen.iter().enumerate() {
         by_step
-            .entry(asm.pieces[c.piece].step.0)
+            .entry(asm.pieces[c.before].step.0)
             .or_default()
             .push(k);
     }
+    // Hung pieces that move to stand on their columns.
+    let moved: HashSet<usize> = chosen
+        .iter()
+        .filter(|c| c.moves())
+        .map(|c| c.piece)
+        .collect();
     // Pieces a step holds.
     let mut held: HashMap<u32, usize> = HashMap::new();
     for p in &asm.pieces {
@@ -581,7 +616,7 @@ fn insert(
     let mut placed = Vec::new();
     let mut shift = 0;
     let mut last_step = None;
-    for p in &asm.pieces {
+    for (i, p) in asm.pieces.iter().enumerate() {
         if last_step != Some(p.step.0) {
             last_step = Some(p.step.0);
             if let (Some(ks), Some((at, n))) = (by_step.get(&p.step.0), plans.get(&p.step.0)) {
@@ -619,7 +654,28 @@ fn insert(
                 if own_steps {
                     shift += n;
                 }
+                // The hung pieces these columns hold, on them, first in
+                // the step of the piece they hung from: on a column under
+                // one end, a piece may not stand alone until that piece
+                // is on it.
+                let mut on: Vec<usize> = ks
+                    .iter()
+                    .map(|&k| &chosen[k])
+                    .filter(|c| c.moves())
+                    .map(|c| c.piece)
+                    .collect();
+                on.sort_unstable();
+                on.dedup();
+                for q in on {
+                    pieces.push(Placed {
+                        step: Step(p.step.0 + shift),
+                        ..asm.pieces[q]
+                    });
+                }
             }
+        }
+        if moved.contains(&i) {
+            continue;
         }
         pieces.push(Placed {
             step: Step(p.step.0 + shift),
