@@ -78,7 +78,7 @@ fn bench(c: &mut Criterion) {
         .first_failure;
     group.bench_function(BenchmarkId::new("support/arch", arch.pieces.len()), |b| {
         b.iter(|| {
-            let shored = shore_up(&arch, &params, fails, 0, Color(71), None)
+            let shored = shore_up(&arch, &params, fails, 0, Color(71), None, false)
                 .expect("solves")
                 .expect("columns");
             assert!(shored.stands);

@@ -12,7 +12,8 @@
 //!    **candidate column**; under a piece hung from one built before it
 //!    (pressed on from below, as a table top's first course between its
 //!    legs), only if the piece moves to stand on the column, first in the
-//!    step of the piece it hung from, and at a higher price;
+//!    step of the piece it hung from, and only when the caller allows it
+//!    (after every other repair) and no other candidate helps;
 //! 2. one linear program (`model::solve_propped`) lets every candidate push its
 //!    piece up, at a price per unit of force, while no stud joint may use
 //!    more than [`TARGET`] of its clutch: the candidates it leans on are
@@ -164,8 +165,10 @@ pub struct Shored {
 /// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
 /// (counting `already`) are in, or the deadline passes (a round that
 /// would end past it, taking as long as the round before, does not
-/// start). Columns are made of pieces in `color`. `None` when no column
-/// could be added.
+/// start). Columns are made of pieces in `color`. With `moves`, a column
+/// may go under a piece hung from one built before it, which moves to
+/// stand on it (where no other column helps; see the module docs). `None`
+/// when no column could be added.
 pub fn shore_up(
     assembly: &Assembly,
     params: &Params,
@@ -173,6 +176,7 @@ pub fn shore_up(
     already: usize,
     color: Color,
     deadline: Option<std::time::Instant>,
+    moves: bool,
 ) -> Result<Option<Shored>, PhysicsError> {
     let mut asm = assembly.clone();
     let mut upto = upto;
@@ -211,7 +215,7 @@ pub fn shore_up(
         // or they would enclose a later piece) are planned again without.
         let mut found = None;
         for _ in 0..TRIES {
-            let chosen = plan(&asm, end, params, room.min(PER_ROUND), &excluded)?;
+            let chosen = plan(&asm, end, params, room.min(PER_ROUND), &excluded, moves)?;
             solves += 1;
             if chosen.is_empty() {
                 break;
@@ -491,14 +495,21 @@ fn plan(
     params: &Params,
     max: usize,
     excluded: &HashSet<Footprint>,
+    moves: bool,
 ) -> Result<Vec<Candidate>, PhysicsError> {
     let bodies: Vec<Body> = asm
         .pieces
         .iter()
         .map(|p| p.placement.body(asm.layer_ldu))
         .collect();
-    let all = candidates(asm, &bodies, end, excluded);
-    if all.is_empty() {
+    let (mut moving, fixed): (Vec<Candidate>, Vec<Candidate>) =
+        candidates(asm, &bodies, end, excluded)
+            .into_iter()
+            .partition(Candidate::moves);
+    if !moves {
+        moving.clear();
+    }
+    if fixed.is_empty() && moving.is_empty() {
         return Ok(Vec::new());
     }
     let prefix = Assembly {
@@ -506,6 +517,31 @@ fn plan(
         layer_ldu: asm.layer_ldu,
     };
     let s = Structure::new(&prefix, params);
+    // The columns under pieces that stay where they are first; those
+    // under hung pieces, which move, only where none of those helps (a
+    // piece moved changes the steps around it).
+    let chosen = choose(&s, &bodies, end, params, max, &fixed)?;
+    if !chosen.is_empty() || moving.is_empty() {
+        return Ok(chosen);
+    }
+    let all: Vec<Candidate> = fixed.into_iter().chain(moving).collect();
+    choose(&s, &bodies, end, params, max, &all)
+}
+
+/// Of the candidate columns `all` under the structure `s` of the first
+/// `end` pieces, the ones its propped program leans on most, at most
+/// `max`, one a cell; none if it leans on none.
+fn choose(
+    s: &Structure,
+    bodies: &[Body],
+    end: usize,
+    params: &Params,
+    max: usize,
+    all: &[Candidate],
+) -> Result<Vec<Candidate>, PhysicsError> {
+    if all.is_empty() {
+        return Ok(Vec::new());
+    }
     let props: Vec<Prop> = all
         .iter()
         .map(|c| Prop {
@@ -520,7 +556,7 @@ fn plan(
     let pieces: Vec<usize> = (0..end).collect();
     let contacts: Vec<_> = s.contacts.iter().collect();
     let solved = solve_propped(
-        &s,
+        s,
         &pieces,
         &contacts,
         params,
@@ -790,7 +826,7 @@ mod tests {
         let params = Params::default();
         let asm = gallows();
         assert!(!analyze(&asm, &params).unwrap().stands());
-        let shored = shore_up(&asm, &params, None, 0, Color(71), None)
+        let shored = shore_up(&asm, &params, None, 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
@@ -838,7 +874,7 @@ mod tests {
             assert!(p.placement.body(24).cells().all(|c| !model.contains(&c)));
         }
         // The same input gives the same columns.
-        let again = shore_up(&asm, &params, None, 0, Color(71), None)
+        let again = shore_up(&asm, &params, None, 0, Color(71), None, false)
             .unwrap()
             .unwrap();
         assert_eq!(again.assembly, shored.assembly);
@@ -858,7 +894,7 @@ mod tests {
             layer_ldu: 24,
         };
         assert!(!analyze(&asm, &params).unwrap().stands());
-        let shored = shore_up(&asm, &params, None, 0, Color(71), None)
+        let shored = shore_up(&asm, &params, None, 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
@@ -895,19 +931,21 @@ mod tests {
     fn a_step_is_shored_up_with_columns_before_it_and_a_standing_build_is_left_alone() {
         let params = Params::default();
         let asm = gallows();
-        let shored = shore_up(&asm, &params, Some(4), 0, Color(71), None)
+        let shored = shore_up(&asm, &params, Some(4), 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
         assert_eq!(shored.columns.len(), 1);
         // Up to step 3 the post stands: nothing to do.
-        assert!(shore_up(&asm, &params, Some(3), 0, Color(71), None)
+        assert!(shore_up(&asm, &params, Some(3), 0, Color(71), None, false)
             .unwrap()
             .is_none());
         // No room left for columns: nothing added.
-        assert!(shore_up(&asm, &params, None, MAX_COLUMNS, Color(71), None)
-            .unwrap()
-            .is_none());
+        assert!(
+            shore_up(&asm, &params, None, MAX_COLUMNS, Color(71), None, false)
+                .unwrap()
+                .is_none()
+        );
     }
 
     #[test]

@@ -250,7 +250,14 @@ pub fn settle(
         // The model without columns, if not analysed yet, is not: one
         // program at a time beside the check.
         unrepaired = unrepaired.filter(Result::is_ok);
-        shored = support(&mut best, params, deadline, &mut counts)?;
+        shored = support(
+            &mut best,
+            params,
+            deadline,
+            &mut counts,
+            Shoring::default(),
+            false,
+        )?;
     }
     if mode == Stability::Repair && best.check.first_failure.is_some() {
         // Other layouts of the same voxels; the first that stands at every
@@ -305,7 +312,29 @@ pub fn settle(
         // The layout kept in place of the shored one gets its own
         // columns where it still fails.
         if reseeded.is_some() && supports && best.check.first_failure.is_some() {
-            shored = support(&mut best, params, deadline, &mut counts)?;
+            shored = support(
+                &mut best,
+                params,
+                deadline,
+                &mut counts,
+                Shoring::default(),
+                false,
+            )?;
+        }
+        // Last, columns under pieces hung from others, which move to stand
+        // on them: they change the steps around them, so they come only
+        // where neither the other columns nor another layout made every
+        // step stand (the bunny at 32 studs stands on seed 2's layout with
+        // no column rather than on seed 1's with three).
+        if supports && best.check.first_failure.is_some() {
+            shored = support(
+                &mut best,
+                params,
+                deadline,
+                &mut counts,
+                std::mem::take(&mut shored),
+                true,
+            )?;
         }
         if let Some(other) = reseeded {
             repairs.push(format!(
@@ -889,17 +918,19 @@ struct Shoring {
 /// they change on to the next failure only, which the next round props.
 /// A round is kept only if more of the model's own pieces stand; at the
 /// end, the steps not yet checked are, so that the report has them all.
+/// `kept`: the columns `best` has already (and their colour); `moves`:
+/// columns may go under hung pieces, which move onto them (see
+/// [`shore_up`]).
 fn support(
     best: &mut Attempt,
     params: &Params,
     deadline: Instant,
     counts: &mut Counts,
+    mut kept: Shoring,
+    moves: bool,
 ) -> Result<Shoring, crate::pipeline::BuildError> {
-    let color = support_color(&best.plan.1);
-    let mut kept = Shoring {
-        columns: Vec::new(),
-        color: Some(color),
-    };
+    let color = kept.color.unwrap_or_else(|| support_color(&best.plan.1));
+    kept.color = Some(color);
     // A round analyses the model at least twice (before and with its
     // columns): one that cannot end by the deadline does not start.
     let round = 2 * best.analysis_time();
@@ -915,6 +946,7 @@ fn support(
             kept.columns.len(),
             color,
             Some(deadline),
+            moves,
         )?
         else {
             break;
