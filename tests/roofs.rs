@@ -25,6 +25,11 @@ fn build(path: &Path, studs: u32, slopes: bool) -> Assembly {
 
 /// [`build`] with `rules`.
 fn build_by(path: &Path, studs: u32, rules: &RuleSet) -> Assembly {
+    build_with(path, studs, rules, &SearchOptions::default())
+}
+
+/// [`build_by`] with search options `opts`.
+fn build_with(path: &Path, studs: u32, rules: &RuleSet, opts: &SearchOptions) -> Assembly {
     let mesh = brickwright::mesh::load(path).unwrap();
     let vopts = VoxelizeOptions::default()
         .with_sizing(Sizing::Studs(studs))
@@ -35,7 +40,7 @@ fn build_by(path: &Path, studs: u32, rules: &RuleSet) -> Assembly {
         surface: Some(&model.surface),
         ..Default::default()
     };
-    let out = search::build_guided(&model.grid, guide, rules, &SearchOptions::default()).unwrap();
+    let out = search::build_guided(&model.grid, guide, rules, opts).unwrap();
     let asm = Assembly::from_order(&search::placements(&out), rules.layer_ldu(), Color::RED);
     let report = verify(&asm, Some(&out.voxels));
     assert!(report.is_ok(), "{}: {report}", path.display());
@@ -230,6 +235,45 @@ fn ellipsoid(a: f64, b: f64, c: f64, n: usize) -> String {
         }
     }
     obj
+}
+
+/// On a flat base (the stability stage's relayout where a keel of
+/// inverted slopes tipped a build over), the lowest course has no
+/// inverted slope: it stands on the table on whole bottoms. The pebble's
+/// rounded underside meets the table in inverted slopes otherwise.
+#[test]
+fn a_flat_base_has_no_inverted_slope_in_its_lowest_course() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pebble.obj");
+    std::fs::write(&path, ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
+    let keel = |a: &Assembly| {
+        let bottom = a.pieces.iter().map(|p| p.placement.origin.z).min();
+        a.pieces
+            .iter()
+            .filter(|p| {
+                Some(p.placement.origin.z) == bottom && p.placement.part.spec().shape.is_inverted()
+            })
+            .count()
+    };
+    let rounded = build(&path, 20, true);
+    assert!(
+        keel(&rounded) > 0,
+        "the pebble meets the table in inverted slopes"
+    );
+    let flat = build_with(
+        &path,
+        20,
+        &rules(true),
+        &SearchOptions::default().with_flat_base(true),
+    );
+    assert_eq!(keel(&flat), 0);
+    // Underneath above the lowest course, inverted slopes still.
+    let inverted = flat
+        .pieces
+        .iter()
+        .filter(|p| p.placement.part.spec().shape.is_inverted())
+        .count();
+    assert!(inverted > 0);
 }
 
 #[test]

@@ -456,9 +456,16 @@ fn candidates(
                         (x0..x0 + sx).all(|x| {
                             (zb + 1..z).all(|zz| free(x, y, zz))
                                 && base(x, y).is_some_and(|q| q.is_some() == lands_on.is_some())
-                                && owner.get(&Cell::new(x, y, z)).is_none_or(|&j| {
-                                    j == i || (j >= step_start[i] && hanger[j].is_none())
-                                })
+                                && match owner.get(&Cell::new(x, y, z)) {
+                                    // Under a piece that moves, wholly
+                                    // under it: what is over the rest may
+                                    // be built before the column.
+                                    _ if before != i => owner.get(&Cell::new(x, y, z)) == Some(&i),
+                                    None => true,
+                                    Some(&j) => {
+                                        j == i || (j >= step_start[i] && hanger[j].is_none())
+                                    }
+                                }
                         })
                     })
             };

@@ -30,6 +30,10 @@ pub(super) struct Planner<'a> {
     /// The layouts being made are the last resort: they leave out what no
     /// order can put in place ([`search::SearchOptions::leave_unplaceable`]).
     last_resort: Cell<bool>,
+    /// Lay no inverted slope in the lowest course (see
+    /// [`crate::search::SearchOptions::flat_base`]): the stability
+    /// stage's other layouts.
+    pub(super) flat_base: Cell<bool>,
 }
 
 /// Layouts made again with other seeds when one fails verification.
@@ -54,6 +58,7 @@ impl<'a> Planner<'a> {
             verify_secs: Cell::new(0.0),
             notes: RefCell::new(Vec::new()),
             last_resort: Cell::new(false),
+            flat_base: Cell::new(false),
         }
     }
 
@@ -229,7 +234,8 @@ impl<'a> Planner<'a> {
             .clone()
             .with_seed(seed)
             .with_cap_stairs(cap && opts.search.cap_stairs)
-            .with_leave_unplaceable(self.last_resort.get());
+            .with_leave_unplaceable(self.last_resort.get())
+            .with_flat_base(self.flat_base.get() || opts.search.flat_base);
         let outcome = search::build_guided(&model.grid, guide, self.rules, &search_opts).map_err(
             |reason| BuildError::Search {
                 file: self.file.clone(),

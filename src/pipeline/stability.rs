@@ -153,6 +153,9 @@ pub struct StabilityReport {
     pub support_pieces: usize,
     /// The seed of the layout kept, when the repair searched again.
     pub reseeded: Option<u64>,
+    /// Whether the layout kept was laid again with no inverted slope in
+    /// its lowest course (see [`crate::search::SearchOptions::flat_base`]).
+    pub flat_base: bool,
     /// How the build stood before repairs, when it was repaired.
     pub before: Option<Before>,
     /// When the build still fails on a table: whether it would stand at
@@ -188,7 +191,9 @@ pub struct StabilityReport {
 pub type Plan = (SearchOutcome, Assembly, &'static str);
 
 /// Runs the stage on `plan`. `supports`: the repair may add support
-/// columns. `replan(seed)` searches again with another seed. `tell` hears
+/// columns. `replan(seed, flat)` searches again with another seed, with no
+/// inverted slope in the lowest course if `flat` (see
+/// [`crate::search::SearchOptions::flat_base`]). `tell` hears
 /// how many of the plan's steps the first check has covered, for a
 /// progress display. Returns the plan to write, possibly repaired, and the
 /// report.
@@ -200,7 +205,7 @@ pub fn settle(
     params: &Params,
     budget: Duration,
     supports: bool,
-    replan: &dyn Fn(u64) -> Result<Plan, crate::pipeline::BuildError>,
+    replan: &dyn Fn(u64, bool) -> Result<Plan, crate::pipeline::BuildError>,
     tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
     // A budget too large for the clock is no budget (about 31 years).
@@ -243,6 +248,7 @@ pub fn settle(
         None
     };
     let mut reseeded = None;
+    let mut flat_base = false;
     let mut repairs = Vec::new();
     // Support columns first: they keep the model's own layout.
     let mut shored = Shoring::default();
@@ -268,14 +274,22 @@ pub fn settle(
         // which must be made by then: while it is being made, how long it
         // takes is not known).
         let analysis = best.analysis_time_by(params, deadline, &mut counts)?;
-        for k in 1..=RESEEDS {
+        // First, where the lowest course has inverted slopes, the same
+        // seed with none there: a keel of them stands on their back rows
+        // only (the glider at 48 studs with `--slopes` tipped over at step
+        // 6 on one, and stands on a flat one).
+        let keeled = keel(&best.plan.1);
+        let layouts = keeled
+            .then_some((seed, true))
+            .into_iter()
+            .chain((1..=RESEEDS).map(|k| (seed.wrapping_add(k), false)));
+        for (other, flat) in layouts {
             if analysis.is_none_or(|a| Instant::now() + a >= deadline) {
                 break;
             }
             tried += 1;
-            let other = seed.wrapping_add(k);
             // A layout that cannot be verified is not a candidate.
-            let planned = match replan(other) {
+            let planned = match replan(other, flat) {
                 Ok(p) => p,
                 Err(crate::pipeline::BuildError::Unverified { .. }) => continue,
                 Err(e) => return Err(e),
@@ -283,7 +297,10 @@ pub fn settle(
             // The finished model first: one analysis rules most layouts out.
             let last = analyze(&planned.1, params)?;
             counts.solves += 1;
-            if !last.stands()
+            // The same voxels on a flat base are kept for what their
+            // columns do: the finished model may need them too.
+            if !flat
+                && !last.stands()
                 && ({
                     let f = best.finished(params, &mut counts)?;
                     f.stands() || last.min_score <= f.min_score
@@ -300,10 +317,17 @@ pub fn settle(
                 None,
                 Some(last),
             )?;
+            // Compared with the first layout as shored up, the flat one is
+            // shored up first too.
+            let mut own = Shoring::default();
+            if flat && supports && candidate.check.first_failure.is_some() {
+                own = support(&mut candidate, params, deadline, &mut counts, own, false)?;
+            }
             if candidate.better_than(&mut best, params, &mut counts)? {
                 best = candidate;
                 reseeded = Some(other);
-                shored = Shoring::default();
+                flat_base = flat;
+                shored = own;
             }
             if best.check.first_failure.is_none() {
                 break;
@@ -317,7 +341,7 @@ pub fn settle(
                 params,
                 deadline,
                 &mut counts,
-                Shoring::default(),
+                std::mem::take(&mut shored),
                 false,
             )?;
         }
@@ -336,7 +360,16 @@ pub fn settle(
                 true,
             )?;
         }
-        if let Some(other) = reseeded {
+        if flat_base {
+            repairs.push(format!(
+                "layout: the search laid the same voxels again with no inverted slope in the lowest course, which stands on the table, and kept that ({})",
+                if best.check.first_failure.is_none() {
+                    "it stands at every step"
+                } else {
+                    "it fails later or less"
+                }
+            ));
+        } else if let Some(other) = reseeded {
             repairs.push(format!(
                 "layout: the search tried other layouts of the same voxels and kept seed {other}'s ({})",
                 if best.check.first_failure.is_none() {
@@ -460,7 +493,7 @@ pub fn settle(
         repairs,
         order_fix.unwrap_or_default(),
         (shored.columns, supports.len()),
-        reseeded,
+        (reseeded, flat_base),
         repaired.then_some(before),
         on_baseplate,
         counts,
@@ -1032,6 +1065,15 @@ fn support(
     Ok(kept)
 }
 
+/// Whether the lowest course of `asm` has an inverted slope in it (see
+/// [`crate::search::SearchOptions::flat_base`]).
+fn keel(asm: &Assembly) -> bool {
+    let bottom = asm.pieces.iter().map(|p| p.placement.origin.z).min();
+    asm.pieces.iter().any(|p| {
+        Some(p.placement.origin.z) == bottom && p.placement.part.spec().shape.is_inverted()
+    })
+}
+
 /// The first step of `after` that differs from `before` (1 when none
 /// does).
 fn first_change(before: &Assembly, after: &Assembly) -> u32 {
@@ -1103,7 +1145,7 @@ fn report(
     repairs: Vec<String>,
     moved: Vec<Moved>,
     (supports, support_pieces): (Vec<Column>, usize),
-    reseeded: Option<u64>,
+    (reseeded, flat_base): (Option<u64>, bool),
     before: Option<Before>,
     stands_on_baseplate: Option<bool>,
     counts: Counts,
@@ -1134,6 +1176,7 @@ fn report(
         support_pieces,
         supports,
         reseeded,
+        flat_base,
         before,
         stands_on_baseplate,
         complete: check.complete,
@@ -1280,7 +1323,12 @@ pub(super) fn stage(
         &Params::default(),
         opts.stability_budget,
         opts.supports,
-        &|seed| planner.plan(seed),
+        &|seed, flat| {
+            planner.flat_base.set(flat);
+            let planned = planner.plan(seed);
+            planner.flat_base.set(false);
+            planned
+        },
         Some(&tell),
     )?;
     if opts.stability == Stability::Check && report.first_failure.is_some() {

@@ -260,6 +260,9 @@ pub(crate) struct Layout<'a> {
     pub slant: Option<&'a Slant>,
     /// Cells no piece may fill: the inside of a hollow build.
     pub keep_empty: Option<&'a VoxelGrid>,
+    /// No inverted slope in the lowest course (see
+    /// [`crate::search::SearchOptions::flat_base`]).
+    pub flat_base: bool,
     /// Cells of `keep_empty` given back to the layout: an inner pillar
     /// under a piece that could not be put in place over the hollow.
     pub released: std::collections::HashSet<Cell>,
@@ -382,6 +385,7 @@ impl<'a> Layout<'a> {
             near,
             slant,
             keep_empty: None,
+            flat_base: false,
             released: std::collections::HashSet::new(),
             refused: std::collections::HashSet::new(),
             colors: None,
@@ -900,6 +904,12 @@ impl<'a> Layout<'a> {
             && origin.z.rem_euclid(self.course) != 0;
         let placement = Placement::new(shape.part, origin, shape.rot);
         let body = shape.body.moved(origin.x, origin.y, origin.z);
+        // With a flat base, the lowest course stands on the table in
+        // pieces that stand on their whole bottoms (see
+        // `SearchOptions::flat_base`).
+        if self.flat_base && body.bbox.min.z == 0 && shape.part.spec().shape.is_inverted() {
+            return None;
+        }
         let (inside, near, far) = self.fits(&placement, &body, reach)?;
         let w = self.weights;
         let below = self.below(&body);

@@ -108,6 +108,12 @@ pub struct SearchOptions {
     /// `false`: a build tries other layouts first, and this is its last
     /// resort.
     pub leave_unplaceable: bool,
+    /// Lay no inverted slope in the lowest course, which stands on the
+    /// table: it would stand on its back row only. Default `false` (a
+    /// rounded underside meets the table in inverted slopes); the
+    /// stability stage's other layouts set it, since a keel of them can
+    /// tip a build over (the glider at 48 studs with `--slopes`).
+    pub flat_base: bool,
 }
 
 /// Which search builds the voxels.
@@ -134,6 +140,7 @@ impl Default for SearchOptions {
             cut: true,
             cap_stairs: true,
             leave_unplaceable: false,
+            flat_base: false,
         }
     }
 }
@@ -185,6 +192,12 @@ impl SearchOptions {
     /// Sets whether stair edges are capped with slopes after the layout.
     pub fn with_cap_stairs(mut self, cap: bool) -> Self {
         self.cap_stairs = cap;
+        self
+    }
+
+    /// Sets [`SearchOptions::flat_base`].
+    pub fn with_flat_base(mut self, flat: bool) -> Self {
+        self.flat_base = flat;
         self
     }
 
@@ -425,6 +438,7 @@ pub fn build_guided(
     layout.repairs = repairs;
     layout.colors = guide.colors.filter(|c| c.len() == fixed.len());
     layout.keep_empty = emptied.as_ref();
+    layout.flat_base = opts.flat_base;
     let mut dice = Dice::new(opts.seed);
     layout.lay(opts, &mut dice, deadline, guide.progress);
     layout.join(&mut dice.rules);

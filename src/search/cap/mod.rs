@@ -565,6 +565,11 @@ impl Layout<'_> {
     fn bare_over(&self, a: Cell, b: &CellBox, up: bool) -> bool {
         let dz = if up { b.sz } else { -1 };
         let q = a.offset(0, 0, dz);
+        // With a flat base, the table under the lowest course is
+        // something (see `SearchOptions::flat_base`).
+        if !up && q.z < 0 && self.flat_base {
+            return false;
+        }
         !self.must.in_bounds(q) || (self.owner_of(q).is_none() && !self.must.get(q))
     }
 
