@@ -334,49 +334,36 @@ pub fn settle(
             }
         }
         // The layout kept in place of the shored one gets its own
-        // columns where it still fails.
-        if reseeded.is_some() && supports && best.check.first_failure.is_some() {
-            shored = support(
-                &mut best,
-                params,
-                deadline,
-                &mut counts,
-                std::mem::take(&mut shored),
-                false,
-            )?;
+        // columns where it still fails. Last, columns under pieces hung
+        // from others, which move to stand on them: they change the steps
+        // around them, so they come only where neither the other columns
+        // nor another layout made every step stand (the bunny at 32 studs
+        // stands on seed 2's layout with no column rather than on seed
+        // 1's with three).
+        for moves in [false, true] {
+            if supports && best.check.first_failure.is_some() && (moves || reseeded.is_some()) {
+                shored = support(
+                    &mut best,
+                    params,
+                    deadline,
+                    &mut counts,
+                    std::mem::take(&mut shored),
+                    moves,
+                )?;
+            }
         }
-        // Last, columns under pieces hung from others, which move to stand
-        // on them: they change the steps around them, so they come only
-        // where neither the other columns nor another layout made every
-        // step stand (the bunny at 32 studs stands on seed 2's layout with
-        // no column rather than on seed 1's with three).
-        if supports && best.check.first_failure.is_some() {
-            shored = support(
-                &mut best,
-                params,
-                deadline,
-                &mut counts,
-                std::mem::take(&mut shored),
-                true,
-            )?;
-        }
+        let outcome = if best.check.first_failure.is_none() {
+            "it stands at every step"
+        } else {
+            "it fails later or less"
+        };
         if flat_base {
             repairs.push(format!(
-                "layout: the search laid the same voxels again with no inverted slope in the lowest course, which stands on the table, and kept that ({})",
-                if best.check.first_failure.is_none() {
-                    "it stands at every step"
-                } else {
-                    "it fails later or less"
-                }
+                "layout: the search laid the same voxels again with no inverted slope in the lowest course, which stands on the table, and kept that ({outcome})"
             ));
         } else if let Some(other) = reseeded {
             repairs.push(format!(
-                "layout: the search tried other layouts of the same voxels and kept seed {other}'s ({})",
-                if best.check.first_failure.is_none() {
-                    "it stands at every step"
-                } else {
-                    "it fails later or less"
-                }
+                "layout: the search tried other layouts of the same voxels and kept seed {other}'s ({outcome})"
             ));
         } else if tried == 0 {
             repairs.push(
