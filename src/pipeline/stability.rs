@@ -274,15 +274,15 @@ pub fn settle(
         // which must be made by then: while it is being made, how long it
         // takes is not known).
         let analysis = best.analysis_time_by(params, deadline, &mut counts)?;
-        // First, where the lowest course has inverted slopes, the same
-        // seed with none there: a keel of them stands on their back rows
-        // only (the glider at 48 studs with `--slopes` tipped over at step
-        // 6 on one, and stands on a flat one).
+        // Last, where the lowest course has inverted slopes, the same seed
+        // with none there: a keel of them stands on their back rows only
+        // (the glider at 48 studs with `--slopes` tipped over at step 6 on
+        // one, and stands on a flat one). After the other seeds, which
+        // may stand with no column (the bunny at 48 studs, seed 2).
         let keeled = keel(&best.plan.1);
-        let layouts = keeled
-            .then_some((seed, true))
-            .into_iter()
-            .chain((1..=RESEEDS).map(|k| (seed.wrapping_add(k), false)));
+        let layouts = (1..=RESEEDS)
+            .map(|k| (seed.wrapping_add(k), false))
+            .chain(keeled.then_some((seed, true)));
         for (other, flat) in layouts {
             if analysis.is_none_or(|a| Instant::now() + a >= deadline) {
                 break;
