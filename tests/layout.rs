@@ -1,6 +1,7 @@
 //! The layout on real input: the whole shape built, interlocked, with few
 //! and big pieces, deterministic, with bricks, slopes and plates.
 
+use crate::common;
 use brickwright::assembly::{metrics, verify::verify, Assembly};
 use brickwright::catalog::{Color, Family};
 use brickwright::geom::Cell;
@@ -178,55 +179,22 @@ fn a_diagonal_rod_one_voxel_thick_is_built_whole() {
 /// fin is one voxel across and its far columns start higher and higher,
 /// each touching the one before only along an edge.
 fn pillar_with_fin(thick: f64, rise: f64) -> String {
-    let mut verts: Vec<(f64, f64, f64)> = Vec::new();
-    let mut obj = String::new();
-    let mut add = |bottom: [(f64, f64, f64); 4], top: f64| {
-        let b = verts.len() + 1;
-        verts.extend(bottom);
-        verts.extend(bottom.map(|(x, y, _)| (x, y, top)));
-        for [p, q, r] in [
-            [0, 1, 2],
-            [0, 2, 3],
-            [4, 6, 5],
-            [4, 7, 6],
-            [0, 4, 5],
-            [0, 5, 1],
-            [1, 5, 6],
-            [1, 6, 2],
-            [2, 6, 7],
-            [2, 7, 3],
-            [3, 7, 4],
-            [3, 4, 0],
-        ] {
-            obj += &format!("f {} {} {}\n", b + p, b + q, b + r);
-        }
-    };
-    add(
-        [
-            (0.0, 0.0, 0.0),
-            (2.0, 0.0, 0.0),
-            (2.0, 2.0, 0.0),
-            (0.0, 2.0, 0.0),
-        ],
-        8.0,
-    );
+    let pillar = [
+        (0.0, 0.0, 0.0),
+        (2.0, 0.0, 0.0),
+        (2.0, 2.0, 0.0),
+        (0.0, 2.0, 0.0),
+    ];
     let d = std::f64::consts::FRAC_1_SQRT_2;
     let (len, t) = (6.0, thick / 2.0);
     let (near0, near1) = ((1.6 - d * t, 1.6 + d * t), (1.6 + d * t, 1.6 - d * t));
-    add(
-        [
-            (near0.0, near0.1, 4.0),
-            (near1.0, near1.1, 4.0),
-            (near1.0 + d * len, near1.1 + d * len, 4.0 + rise),
-            (near0.0 + d * len, near0.1 + d * len, 4.0 + rise),
-        ],
-        8.0,
-    );
-    let v: String = verts
-        .iter()
-        .map(|(x, y, z)| format!("v {x} {z} {y}\n"))
-        .collect();
-    v + &obj
+    let fin = [
+        (near0.0, near0.1, 4.0),
+        (near1.0, near1.1, 4.0),
+        (near1.0 + d * len, near1.1 + d * len, 4.0 + rise),
+        (near0.0 + d * len, near0.1 + d * len, 4.0 + rise),
+    ];
+    common::prisms(&[(pillar, 8.0), (fin, 8.0)])
 }
 
 /// The fin's far end meets the rest only at edges: it is built whole,

@@ -236,33 +236,14 @@ fn write_table(dir: &Path) -> PathBuf {
         let (x, z) = (8.5 * sx, 4.5 * sz);
         boxes.push(([x - 0.5, 0.0, z - 0.5], [x + 0.5, 10.5, z + 0.5]));
     }
-    let mut obj = String::new();
-    for (k, (lo, hi)) in boxes.iter().enumerate() {
-        // Corners by bits (x, y, z), then the twelve outward triangles.
-        for i in 0..8 {
-            let pick = |bit: usize, a: usize| if i >> bit & 1 == 1 { hi[a] } else { lo[a] };
-            obj += &format!("v {} {} {}\n", pick(2, 0), pick(1, 1), pick(0, 2));
-        }
-        let o = 8 * k + 1;
-        for [a, b, c] in [
-            [0, 1, 3],
-            [0, 3, 2],
-            [4, 6, 7],
-            [4, 7, 5],
-            [0, 4, 5],
-            [0, 5, 1],
-            [2, 3, 7],
-            [2, 7, 6],
-            [0, 2, 6],
-            [0, 6, 4],
-            [1, 5, 7],
-            [1, 7, 3],
-        ] {
-            obj += &format!("f {} {} {}\n", a + o, b + o, c + o);
-        }
-    }
+    let solids: Vec<_> = boxes
+        .iter()
+        .map(|&([x0, y0, z0], [x1, y1, z1])| {
+            ([(x0, z0, y0), (x1, z0, y0), (x1, z1, y0), (x0, z1, y0)], y1)
+        })
+        .collect();
     let path = dir.join("table.obj");
-    std::fs::write(&path, obj).unwrap();
+    std::fs::write(&path, common::prisms(&solids)).unwrap();
     path
 }
 

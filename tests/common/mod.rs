@@ -288,3 +288,37 @@ pub fn golden_text(path: &Path, got: &str) {
         path.display()
     );
 }
+
+/// Solids of six faces as OBJ text (y up): each a bottom quad, its
+/// corners counter-clockwise seen from above as `(x, z, height)`, and the
+/// height its top lies at over them. Generated meshes of the tests.
+pub fn prisms(solids: &[([(f64, f64, f64); 4], f64)]) -> String {
+    let (mut verts, mut faces) = (String::new(), String::new());
+    for (k, (bottom, top)) in solids.iter().enumerate() {
+        for (x, z, h) in bottom
+            .iter()
+            .copied()
+            .chain(bottom.map(|(x, z, _)| (x, z, *top)))
+        {
+            verts += &format!("v {x} {h} {z}\n");
+        }
+        let b = 8 * k + 1;
+        for [p, q, r] in [
+            [0, 1, 2],
+            [0, 2, 3],
+            [4, 6, 5],
+            [4, 7, 6],
+            [0, 4, 5],
+            [0, 5, 1],
+            [1, 5, 6],
+            [1, 6, 2],
+            [2, 6, 7],
+            [2, 7, 3],
+            [3, 7, 4],
+            [3, 4, 0],
+        ] {
+            faces += &format!("f {} {} {}\n", b + p, b + q, b + r);
+        }
+    }
+    verts + &faces
+}
