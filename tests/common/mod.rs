@@ -289,10 +289,13 @@ pub fn golden_text(path: &Path, got: &str) {
     );
 }
 
-/// Solids of six faces as OBJ text (y up): each a bottom quad, its
-/// corners counter-clockwise seen from above as `(x, z, height)`, and the
-/// height its top lies at over them. Generated meshes of the tests.
-pub fn prisms(solids: &[([(f64, f64, f64); 4], f64)]) -> String {
+/// A solid of six faces: a bottom quad, its corners counter-clockwise seen
+/// from above as `(x, z, height)`, and the height its top lies at over them.
+pub type Prism = ([(f64, f64, f64); 4], f64);
+
+/// Solids of six faces ([`Prism`]) as OBJ text (y up): the generated
+/// meshes of the tests.
+pub fn prisms(solids: &[Prism]) -> String {
     let (mut verts, mut faces) = (String::new(), String::new());
     for (k, (bottom, top)) in solids.iter().enumerate() {
         for (x, z, h) in bottom
