@@ -456,14 +456,17 @@ fn candidates(
                         (x0..x0 + sx).all(|x| {
                             (zb + 1..z).all(|zz| free(x, y, zz))
                                 && base(x, y).is_some_and(|q| q.is_some() == lands_on.is_some())
-                                && match owner.get(&Cell::new(x, y, z)) {
+                                && {
+                                    let over = owner.get(&Cell::new(x, y, z));
                                     // Under a piece that moves, wholly
                                     // under it: what is over the rest may
                                     // be built before the column.
-                                    _ if before != i => owner.get(&Cell::new(x, y, z)) == Some(&i),
-                                    None => true,
-                                    Some(&j) => {
-                                        j == i || (j >= step_start[i] && hanger[j].is_none())
+                                    if before != i {
+                                        over == Some(&i)
+                                    } else {
+                                        over.is_none_or(|&j| {
+                                            j == i || (j >= step_start[i] && hanger[j].is_none())
+                                        })
                                     }
                                 }
                         })
