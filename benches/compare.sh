@@ -10,7 +10,10 @@
 #       slopes (--slopes): bricks, slopes, voxels left out, seconds.
 #
 # STUDS sets the size (default 16); SEED the seed of the slopes runs
-# (default 1), SEEDS the seeds averaged in the rules runs (default 1 to 5).
+# (default 1), SEEDS the seeds averaged in the rules runs (default 1 to 5);
+# SEARCH the search of the rules runs (layout, the default, or backward:
+# the paper's backward tracing, BUDGET seconds a run, default 30; a run
+# that finds no derivation is counted in "built" and left out of the rest).
 set -euo pipefail
 what=${1:?usage: benches/compare.sh rules|slopes MESH...}
 shift
@@ -45,9 +48,10 @@ rules)
   # by a rule the corpus used at all.
   cp rules/default.rules "$out/learned.rules"
   awk '$1 == "rule" { $8 = 1 } $1 == "unseen" { $2 = 1 } { print }' "$out/learned.rules" >"$out/uniform.rules"
-  python3 - "$bin" "$out" "$studs" "${SEEDS:-1 2 3 4 5}" "$@" <<'PY'
+  python3 - "$bin" "$out" "$studs" "${SEEDS:-1 2 3 4 5}" "${SEARCH:-layout}" "${BUDGET:-30}" "$@" <<'PY'
 import json, subprocess, sys
-bin, out, studs, seeds, meshes = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(), sys.argv[5:]
+bin, out, studs, seeds, search, budget = sys.argv[1:7]
+seeds, meshes = seeds.split(), sys.argv[7:]
 lines = [l.split("#")[0].split() + [l] for l in open(f"{out}/learned.rules") if l.strip() and not l.startswith("#")]
 starts = sum(1 for t in lines if t[0] == "start")
 basic = [t for t in lines if t[0] == "rule"]
@@ -55,28 +59,35 @@ bricks = {t[1] for t in lines if t[0] == "part" and "# Brick" in t[-1]}
 corpus = {starts + i: float(t[7]) for i, t in enumerate(basic) if t[1] in bricks and t[2] in bricks}
 total = sum(corpus.values())
 corpus = {k: v / total for k, v in corpus.items()}
-print(f"| mesh | weights | pieces | voxels/piece | seams continued | TV to corpus | people's rules | search s |  (mean of seeds {' '.join(seeds)})")
-print("|---|---|---|---|---|---|---|---|")
+print(f"| mesh | search | weights | built | pieces | voxels/piece | seams continued | TV to corpus | people's rules | search s |  (mean of seeds {' '.join(seeds)})")
+print("|---|---|---|---|---|---|---|---|---|---|")
 for mesh in meshes:
     name = mesh.rsplit("/", 1)[-1]
     for w in ["learned", "uniform"]:
         rows, uses = [], {}
         for seed in seeds:
             d = f"{out}/{name}-{w}-{seed}"
-            subprocess.run([bin, "build", mesh, "-o", d, "--studs", studs, "--seed", seed,
-                            "--rules", f"{out}/{w}.rules", "--stability", "off",
-                            "--formats", "ldr", "--quiet"], check=True)
+            run = subprocess.run([bin, "build", mesh, "-o", d, "--studs", studs, "--seed", seed,
+                                  "--rules", f"{out}/{w}.rules", "--stability", "off",
+                                  "--search", search, "--time-budget", budget,
+                                  "--formats", "ldr", "--quiet"])
+            if run.returncode == 2 and search == "backward":
+                continue  # no derivation within the budget
+            run.check_returncode()
             r = json.load(open(f"{d}/report.json"))
             rows.append(r)
             for k, v in r["derivation"]["uses"].items():
                 if int(k) >= starts:
                     uses[int(k)] = uses.get(int(k), 0) + v
+        if not rows:
+            print(f"| {name} | {search} | {w} | 0 of {len(seeds)} | | | | | | |")
+            continue
         n = sum(uses.values())
         shares = {k: v / n for k, v in uses.items()}
         tv = sum(abs(corpus.get(k, 0) - shares.get(k, 0)) for k in set(corpus) | set(shares)) / 2
         seen = sum(v for k, v in shares.items() if k - starts < len(basic))
         mean = lambda f: sum(f(r) for r in rows) / len(rows)
-        print(f"| {name} | {w} | {mean(lambda r: r['pieces']):.0f} | {mean(lambda r: r['voxels_per_piece']):.2f} "
+        print(f"| {name} | {search} | {w} | {len(rows)} of {len(seeds)} | {mean(lambda r: r['pieces']):.0f} | {mean(lambda r: r['voxels_per_piece']):.2f} "
               f"| {mean(lambda r: r['seams']['fraction']):.3f} | {tv:.3f} | {seen:.0%} "
               f"| {mean(lambda r: r['seconds']['search']):.2f} |")
 PY
