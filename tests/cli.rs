@@ -965,7 +965,8 @@ fn the_mesh_palette_is_the_default_and_colors_limits_it() {
 /// `--search backward` builds the house fixture at 8 studs (two parts,
 /// walls and roof) through the whole pipeline: the build verifies, the
 /// report's derivation has a rule a piece ending (backward) in a starting
-/// rule, and the `.ldr` names each piece's rule.
+/// rule, the `.ldr` names each piece's rule, and the built-in complex
+/// rules are tested (once every fifth node by default, as the paper does).
 #[test]
 fn the_backward_search_builds_the_house_and_writes_its_derivation() {
     let tmp = tempdir();
@@ -999,6 +1000,9 @@ fn the_backward_search_builds_the_house_and_writes_its_derivation() {
     assert_eq!(report["search"]["parts"].as_u64(), Some(2));
     assert_eq!(report["search"]["starts"].as_u64(), Some(1));
     assert_eq!(ldr.matches("0 // rule ").count(), pieces);
+    let nodes = report_u64(&report["search"], "nodes");
+    let tried = report_u64(&report["search"], "complex_tried");
+    assert!(tried > 0 && tried <= nodes / 5 + 1, "{}", report["search"]);
 }
 
 /// A shape the paper's rules cannot build fails at once with one line

@@ -223,9 +223,11 @@ pub struct BuildArgs {
     /// With --search backward, give up after this many tree nodes.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..))]
     pub node_budget: u64,
-    /// Test a complex rule (several pieces at once) once every K search nodes (the paper: 1 to 5); 0 never.
-    #[arg(long, value_name = "K", default_value_t = 0)]
-    pub complex_every: u32,
+    /// Test a complex rule (several pieces at once) once every K search nodes (the paper: 1 to 5);
+    /// 0 never. Default: 5 with --search backward (the paper's "once every fifth node"), 0 with the
+    /// layout.
+    #[arg(long, value_name = "K")]
+    pub complex_every: Option<u32>,
     /// Colour every piece this colour: an LDraw code (4), an LDraw or BrickLink name
     /// ("light bluish grey"), or bl:ID for a BrickLink colour id.
     #[arg(long, conflicts_with = "palette", value_parser = parse_color)]
@@ -285,6 +287,11 @@ pub struct BuildArgs {
 /// (no budget, in effect) rather than overflowing a clock.
 const MAX_BUDGET_SECS: f64 = 1e9;
 
+/// How often the backward search tests a complex rule by default: once
+/// every fifth node, the paper's least frequent setting (section 5: "once
+/// every fifth node to once every node").
+const BACKWARD_COMPLEX_EVERY: u32 = 5;
+
 /// A `--...-budget` value: positive seconds, saturated at [`MAX_BUDGET_SECS`].
 fn budget(option: &str, secs: f64) -> Result<Duration> {
     if !(secs.is_finite() && secs > 0.0) {
@@ -340,7 +347,10 @@ impl BuildArgs {
             .search
             .with_seed(a.seed)
             .with_time_budget(time_budget)
-            .with_complex_every(a.complex_every)
+            .with_complex_every(a.complex_every.unwrap_or(match a.search {
+                SearchArg::Layout => 0,
+                SearchArg::Backward => BACKWARD_COMPLEX_EVERY,
+            }))
             .with_method(match a.search {
                 SearchArg::Layout => brickwright::search::Method::Layout,
                 SearchArg::Backward => brickwright::search::Method::Backward,
