@@ -528,9 +528,21 @@ pub(crate) fn analyze_expecting(
     params: &Params,
     first: model::First,
 ) -> Result<Analysis, PhysicsError> {
+    analyze_by(assembly, params, first, None)
+}
+
+/// [`analyze_expecting`], whose programs stop at `deadline`: past it, a
+/// program not solved gives [`PhysicsError::Solver`].
+pub(crate) fn analyze_by(
+    assembly: &Assembly,
+    params: &Params,
+    first: model::First,
+    deadline: Option<std::time::Instant>,
+) -> Result<Analysis, PhysicsError> {
     let start = std::time::Instant::now();
     params.check()?;
-    let s = model::Structure::new(assembly, params);
+    let mut s = model::Structure::new(assembly, params);
+    s.deadline = deadline;
     let pieces = steps::solve_all_first(&s, assembly.pieces.len(), params, first)?;
     Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
 }

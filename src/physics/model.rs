@@ -45,6 +45,8 @@ pub(super) struct Method {
     /// Whether a hand may hold a piece (see [`HAND_COST`]); without,
     /// a group that needs one has no answer.
     pub hands: bool,
+    /// Past this, the solver stops at its next iteration (no answer).
+    pub until: Option<std::time::Instant>,
 }
 
 impl Method {
@@ -60,6 +62,7 @@ impl Method {
         // unique).
         refine: false,
         hands: true,
+        until: None,
     };
 }
 
@@ -148,6 +151,9 @@ pub(super) struct Structure {
     /// Where the solver says how far it is, with `stop`: the iterations
     /// of the program it is on (see [`Pending`](super::Pending)).
     pub progress: Option<std::sync::Arc<Progress>>,
+    /// Past this, the solver stops at its next iteration too (a program
+    /// with no answer by its caller's deadline gives none).
+    pub deadline: Option<std::time::Instant>,
 }
 
 /// How far the programs of a [`Structure`] went: iterations in all, and
@@ -188,6 +194,7 @@ impl Structure {
             under,
             stop: None,
             progress: None,
+            deadline: None,
         }
     }
 
@@ -410,9 +417,10 @@ fn stopped(s: &Structure) -> bool {
     s.stop
         .as_ref()
         .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+        || s.deadline.is_some_and(|d| std::time::Instant::now() >= d)
 }
 
-/// Which of [`solve`]'s two programs is solved first.
+/// Which of [`solve_until`]'s two programs is solved first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum First {
     /// Within capacity, no hand: for a group expected to stand (a
@@ -445,13 +453,22 @@ pub(crate) enum First {
 /// studs (4,998 pieces) 82 iterations and 53 s, where the least usage's
 /// took 192 iterations and 129 s and then needed the other (it broke a
 /// joint); the bunny at 64 16.2 s where the two took 18.3 and 19.0 s.
-pub(super) fn solve(
+///
+/// Its programs stop at `until`: past it, a program not solved gives
+/// [`PhysicsError::Solver`].
+pub(super) fn solve_until(
     s: &Structure,
     pieces: &[usize],
     contacts: &[&Contact],
     params: &Params,
     first: First,
+    until: Option<std::time::Instant>,
 ) -> Result<Solved, PhysicsError> {
+    let method = Method {
+        until,
+        ..Method::DEFAULT
+    };
+    let late = || stopped(s) || until.is_some_and(|d| std::time::Instant::now() >= d);
     let within = || {
         let held = Props {
             props: &[],
@@ -459,12 +476,12 @@ pub(super) fn solve(
         };
         let bare = Method {
             hands: false,
-            ..Method::DEFAULT
+            ..method
         };
         match solve_by(s, pieces, contacts, params, Some(&held), bare) {
             Ok(held) if !held.stress.iter().any(PieceStress::fails) => Ok(Some(held)),
             // Stopped (its answer no longer wanted): so would the other.
-            Err(e @ PhysicsError::Solver { .. }) if stopped(s) => Err(e),
+            Err(e @ PhysicsError::Solver { .. }) if late() => Err(e),
             // No answer within capacity (or the solver's trouble): the
             // other program says.
             Ok(_) | Err(PhysicsError::Solver { .. }) => Ok(None),
@@ -475,9 +492,9 @@ pub(super) fn solve(
         if let Some(held) = within()? {
             return Ok(held);
         }
-        return solve_propped(s, pieces, contacts, params, None);
+        return solve_by(s, pieces, contacts, params, None, method);
     }
-    let least = solve_propped(s, pieces, contacts, params, None)?;
+    let least = solve_by(s, pieces, contacts, params, None, method)?;
     let breaks = least.stress.iter().any(|p| p.breaks);
     if !breaks || least.stress.iter().any(|p| p.falls) {
         return Ok(least);
@@ -485,7 +502,7 @@ pub(super) fn solve(
     Ok(within()?.unwrap_or(least))
 }
 
-/// [`solve`], where `props` may also push pieces up and every joint's
+/// [`solve_until`], where `props` may also push pieces up and every joint's
 /// usage is held to at most `props.cap`: the props a structure needs to
 /// hold with that margin (a hand still holds what no prop can).
 pub(super) fn solve_propped(
@@ -650,15 +667,20 @@ pub(super) fn solve_by(
         .map_err(|e| PhysicsError::Bug(format!("solver settings: {e}")))?;
     let mut solver = DefaultSolver::new(&pm, &lp.cost, &a, &b, &cones, settings)
         .map_err(|e| PhysicsError::Bug(format!("solver setup: {e:?}")))?;
-    if let Some(stop) = s.stop.clone() {
-        let progress = s.progress.clone();
+    let deadline = match (s.deadline, method.until) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    if s.stop.is_some() || deadline.is_some() {
+        let (stop, progress) = (s.stop.clone(), s.progress.clone());
         solver.set_termination_callback(move |info| {
             use std::sync::atomic::Ordering::Relaxed;
             if let Some(p) = &progress {
                 p.total.fetch_add(1, Relaxed);
                 p.current.store(info.iterations, Relaxed);
             }
-            stop.load(Relaxed)
+            stop.as_ref().is_some_and(|f| f.load(Relaxed))
+                || deadline.is_some_and(|d| std::time::Instant::now() >= d)
         });
     }
     solver.solve();
@@ -730,6 +752,30 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
+    /// A program whose deadline has passed stops at once and gives no
+    /// answer; with none, or one to come, it is solved.
+    #[test]
+    fn a_program_past_its_deadline_gives_no_answer() {
+        let params = Params::default();
+        let asm = crate::physics::fixtures::counterweighted();
+        let s = Structure::new(&asm, &params);
+        let pieces: Vec<usize> = (0..asm.pieces.len()).collect();
+        let contacts: Vec<&Contact> = s.contacts.iter().collect();
+        let now = std::time::Instant::now();
+        for first in [First::Within, First::Least] {
+            let past = solve_until(&s, &pieces, &contacts, &params, first, Some(now));
+            assert!(
+                matches!(past, Err(PhysicsError::Solver { .. })),
+                "{first:?}"
+            );
+            let later = now + std::time::Duration::from_secs(3600);
+            for until in [None, Some(later)] {
+                let solved = solve_until(&s, &pieces, &contacts, &params, first, until).unwrap();
+                assert!(!solved.stress.iter().any(PieceStress::fails));
+            }
+        }
+    }
+
     /// The arch at 24 studs: its linear program shares loads among joints
     /// in more than one way at the same least total usage, and Clarabel's
     /// answer moves with its path. The program with the usages' squares
@@ -746,6 +792,7 @@ mod tests {
                 tolerance,
                 refine,
                 hands: true,
+                until: None,
             };
             usages(&s, n, &params, method)
         };
@@ -781,7 +828,7 @@ mod tests {
             let pieces: Vec<usize> = (0..asm.pieces.len()).collect();
             let contacts: Vec<&Contact> = s.contacts.iter().collect();
             let by = |first| {
-                solve(&s, &pieces, &contacts, &params, first)
+                solve_until(&s, &pieces, &contacts, &params, first, None)
                     .unwrap()
                     .stress
             };

@@ -36,8 +36,8 @@ use std::collections::{HashMap, HashSet};
 
 use serde::Serialize;
 
-use super::model::{solve_propped, Prop, Props, Structure};
-use super::{analyze, Params, PhysicsError};
+use super::model::{solve_propped, First, Prop, Props, Structure};
+use super::{analyze_by, Params, PhysicsError};
 use crate::assembly::verify::{verify, Failure};
 use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_MIN_PIECES, STEP_PIECES};
 use crate::catalog::{Color, PartKind};
@@ -165,7 +165,8 @@ pub struct Shored {
 /// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
 /// (counting `already`) are in, or the deadline passes (a round that
 /// would end past it, taking as long as the round before, does not
-/// start). Columns are made of pieces in `color`. With `moves`, a column
+/// start, and a round's programs stop at it: the columns of the rounds
+/// before are kept). Columns are made of pieces in `color`. With `moves`, a column
 /// may go under a piece hung from one built before it, which moves to
 /// stand on it (where no other column helps; see the module docs). `None`
 /// when no column could be added.
@@ -203,9 +204,16 @@ pub fn shore_up(
             layer_ldu: asm.layer_ldu,
         };
         solves += 1;
-        if analyze(&prefix, params)?.stands() {
-            stands = true;
-            break;
+        // Its programs, and the plan's, stop at the deadline: a round past
+        // it ends the rounds with the columns found so far.
+        match analyze_by(&prefix, params, First::Within, deadline) {
+            Ok(a) if a.stands() => {
+                stands = true;
+                break;
+            }
+            Ok(_) => {}
+            Err(PhysicsError::Solver { .. }) if past(deadline) => break,
+            Err(e) => return Err(e),
         }
         let room = MAX_COLUMNS.saturating_sub(already + columns.len());
         if room == 0 || round == ROUNDS {
@@ -215,7 +223,19 @@ pub fn shore_up(
         // or they would enclose a later piece) are planned again without.
         let mut found = None;
         for _ in 0..TRIES {
-            let chosen = plan(&asm, end, params, room.min(PER_ROUND), &excluded, moves)?;
+            let chosen = match plan(
+                &asm,
+                end,
+                params,
+                room.min(PER_ROUND),
+                &excluded,
+                moves,
+                deadline,
+            ) {
+                Ok(chosen) => chosen,
+                Err(PhysicsError::Solver { .. }) if past(deadline) => break,
+                Err(e) => return Err(e),
+            };
             solves += 1;
             if chosen.is_empty() {
                 break;
@@ -251,6 +271,11 @@ pub fn shore_up(
         stands,
         solves,
     }))
+}
+
+/// Whether `deadline` has passed.
+fn past(deadline: Option<std::time::Instant>) -> bool {
+    deadline.is_some_and(|d| std::time::Instant::now() >= d)
 }
 
 /// The columns of `chosen` (as `(x, y, bottom)`) that make `asm` fail
@@ -506,6 +531,7 @@ fn plan(
     max: usize,
     excluded: &HashSet<Footprint>,
     moves: bool,
+    deadline: Option<std::time::Instant>,
 ) -> Result<Vec<Candidate>, PhysicsError> {
     let bodies: Vec<Body> = asm
         .pieces
@@ -526,7 +552,8 @@ fn plan(
         pieces: asm.pieces[..end].to_vec(),
         layer_ldu: asm.layer_ldu,
     };
-    let s = Structure::new(&prefix, params);
+    let mut s = Structure::new(&prefix, params);
+    s.deadline = deadline;
     // The columns under pieces that stay where they are first; those
     // under hung pieces, which move, only where none of those helps (a
     // piece moved changes the steps around it).
@@ -807,7 +834,7 @@ pub fn support_color(assembly: &Assembly) -> Color {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::analyze_steps;
+    use crate::physics::{analyze, analyze_steps};
 
     fn piece(id: &str, x: i32, z: i32, step: u32) -> Placed {
         Placed {
