@@ -541,8 +541,7 @@ pub(crate) fn analyze_by(
 ) -> Result<Analysis, PhysicsError> {
     let start = std::time::Instant::now();
     params.check()?;
-    let mut s = model::Structure::new(assembly, params);
-    s.deadline = deadline;
-    let pieces = steps::solve_all_first(&s, assembly.pieces.len(), params, first)?;
+    let s = model::Structure::new(assembly, params);
+    let pieces = steps::solve_all_first(&s, assembly.pieces.len(), params, first, deadline)?;
     Ok(Analysis::new(pieces, start.elapsed().as_secs_f64()))
 }

@@ -151,9 +151,6 @@ pub(super) struct Structure {
     /// Where the solver says how far it is, with `stop`: the iterations
     /// of the program it is on (see [`Pending`](super::Pending)).
     pub progress: Option<std::sync::Arc<Progress>>,
-    /// Past this, the solver stops at its next iteration too (a program
-    /// with no answer by its caller's deadline gives none).
-    pub deadline: Option<std::time::Instant>,
 }
 
 /// How far the programs of a [`Structure`] went: iterations in all, and
@@ -194,7 +191,6 @@ impl Structure {
             under,
             stop: None,
             progress: None,
-            deadline: None,
         }
     }
 
@@ -417,7 +413,6 @@ fn stopped(s: &Structure) -> bool {
     s.stop
         .as_ref()
         .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
-        || s.deadline.is_some_and(|d| std::time::Instant::now() >= d)
 }
 
 /// Which of [`solve_until`]'s two programs is solved first.
@@ -511,8 +506,13 @@ pub(super) fn solve_propped(
     contacts: &[&Contact],
     params: &Params,
     extra: Option<&Props>,
+    until: Option<std::time::Instant>,
 ) -> Result<Solved, PhysicsError> {
-    solve_by(s, pieces, contacts, params, extra, Method::DEFAULT)
+    let method = Method {
+        until,
+        ..Method::DEFAULT
+    };
+    solve_by(s, pieces, contacts, params, extra, method)
 }
 
 /// [`solve_propped`] by `method`.
@@ -667,12 +667,8 @@ pub(super) fn solve_by(
         .map_err(|e| PhysicsError::Bug(format!("solver settings: {e}")))?;
     let mut solver = DefaultSolver::new(&pm, &lp.cost, &a, &b, &cones, settings)
         .map_err(|e| PhysicsError::Bug(format!("solver setup: {e:?}")))?;
-    let deadline = match (s.deadline, method.until) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    };
-    if s.stop.is_some() || deadline.is_some() {
-        let (stop, progress) = (s.stop.clone(), s.progress.clone());
+    if s.stop.is_some() || method.until.is_some() {
+        let (stop, progress, until) = (s.stop.clone(), s.progress.clone(), method.until);
         solver.set_termination_callback(move |info| {
             use std::sync::atomic::Ordering::Relaxed;
             if let Some(p) = &progress {
@@ -680,7 +676,7 @@ pub(super) fn solve_by(
                 p.current.store(info.iterations, Relaxed);
             }
             stop.as_ref().is_some_and(|f| f.load(Relaxed))
-                || deadline.is_some_and(|d| std::time::Instant::now() >= d)
+                || until.is_some_and(|d| std::time::Instant::now() >= d)
         });
     }
     solver.solve();

@@ -98,19 +98,9 @@ fn past(deadline: Option<Instant>) -> bool {
 }
 
 /// Solves the jobs in parallel, in order: each job's stress per piece,
-/// how it was found and the seconds its solve took.
+/// how it was found and the seconds its solve took. Programs stop at
+/// `until` (then [`PhysicsError::Solver`]).
 fn run_refs(
-    s: &Structure,
-    jobs: &[&Job],
-    params: &Params,
-    first: First,
-) -> Result<Vec<Answer>, PhysicsError> {
-    run_refs_until(s, jobs, params, first, None)
-}
-
-/// [`run_refs`], its programs stopped at `until` (then
-/// [`PhysicsError::Solver`]).
-fn run_refs_until(
     s: &Structure,
     jobs: &[&Job],
     params: &Params,
@@ -148,17 +138,19 @@ pub(super) fn solve_all(
     n: usize,
     params: &Params,
 ) -> Result<Vec<PieceStress>, PhysicsError> {
-    solve_all_first(s, n, params, First::Within)
+    solve_all_first(s, n, params, First::Within, None)
 }
 
-/// [`solve_all`], each group's programs in the order `first`.
+/// [`solve_all`], each group's programs in the order `first`, stopped at
+/// `until` (then [`PhysicsError::Solver`]).
 pub(super) fn solve_all_first(
     s: &Structure,
     n: usize,
     params: &Params,
     first: First,
+    until: Option<Instant>,
 ) -> Result<Vec<PieceStress>, PhysicsError> {
-    solve_all_but(s, n, params, None, first).map(|(out, _)| out)
+    solve_all_but(s, n, params, None, first, until).map(|(out, _)| out)
 }
 
 /// [`solve_all`], taking from `known` (stress, and whether it is exact)
@@ -171,6 +163,7 @@ fn solve_all_but(
     params: &Params,
     known: Option<(&[PieceStress], &[bool])>,
     first: First,
+    until: Option<Instant>,
 ) -> Result<(Vec<PieceStress>, bool), PhysicsError> {
     let mut g = Groups::new();
     let (mut next, mut reused) = (0, 0);
@@ -187,7 +180,7 @@ fn solve_all_but(
             _ => todo.push(job),
         }
     }
-    let results = run_refs(s, &todo, params, first)?;
+    let results = run_refs(s, &todo, params, first, until)?;
     for (job, (r, _, _)) in todo.iter().zip(results) {
         for (&p, st) in job.pieces.iter().zip(r) {
             out[p] = st;
@@ -823,7 +816,7 @@ fn check_steps_in(
         // the deadline (the fandisk at 96 studs: a group of thousands of
         // pieces at step 189 took its check 28 s past it), and the check
         // is then cut there.
-        let results = match run_refs_until(s, &late, params, First::Least, deadline) {
+        let results = match run_refs(s, &late, params, First::Least, deadline) {
             Err(PhysicsError::Solver { .. }) if past(deadline) => {
                 complete = false;
                 break;
@@ -878,7 +871,7 @@ fn check_steps_in(
         _ => {
             let known = complete.then_some((&current[..end], &exact[..end]));
             let begun = Instant::now();
-            let (last, ran) = solve_all_but(s, end, params, known, First::Within)?;
+            let (last, ran) = solve_all_but(s, end, params, known, First::Within, None)?;
             solves += usize::from(ran);
             // What the finished build's programs take: as solved now, or
             // as the last step checked solved them.

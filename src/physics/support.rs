@@ -552,17 +552,16 @@ fn plan(
         pieces: asm.pieces[..end].to_vec(),
         layer_ldu: asm.layer_ldu,
     };
-    let mut s = Structure::new(&prefix, params);
-    s.deadline = deadline;
+    let s = Structure::new(&prefix, params);
     // The columns under pieces that stay where they are first; those
     // under hung pieces, which move, only where none of those helps (a
     // piece moved changes the steps around it).
-    let chosen = choose(&s, &bodies, end, params, max, &fixed)?;
+    let chosen = choose(&s, &bodies, end, params, max, &fixed, deadline)?;
     if !chosen.is_empty() || moving.is_empty() {
         return Ok(chosen);
     }
     let all: Vec<Candidate> = fixed.into_iter().chain(moving).collect();
-    choose(&s, &bodies, end, params, max, &all)
+    choose(&s, &bodies, end, params, max, &all, deadline)
 }
 
 /// Of the candidate columns `all` under the structure `s` of the first
@@ -575,6 +574,7 @@ fn choose(
     params: &Params,
     max: usize,
     all: &[Candidate],
+    until: Option<std::time::Instant>,
 ) -> Result<Vec<Candidate>, PhysicsError> {
     if all.is_empty() {
         return Ok(Vec::new());
@@ -601,6 +601,7 @@ fn choose(
             props: &props,
             cap: TARGET,
         }),
+        until,
     )?;
     let strongest = solved.props.iter().copied().fold(0.0, f64::max);
     if strongest < 1e-6 {
