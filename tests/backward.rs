@@ -187,20 +187,41 @@ fn a_shape_the_rules_cannot_build_fails_plainly() {
     assert!(e.contains("the node budget (3) ran out"), "{e}");
 }
 
-/// The mug fixture at 15 studs: its ring, one voxel thick, turns its
-/// corners by diagonal steps, and the disc under it is one layer thick, so
-/// the stretch of wall beyond a step is joined to the rest by no piece in
-/// the voxels. The trace says so before it starts, not when its budget
-/// ends.
+/// The mug fixture at 10 studs: its ring, one voxel thick, turns its
+/// corners by diagonal steps and its handle climbs by them, which no piece
+/// holds (two voxels that meet along an edge). A voxel is added at each
+/// step (`repairs.extra_cells`, as the layout's cells outside), and the
+/// mug is traced backward whole and verifies.
 #[test]
-fn the_mug_as_voxelized_cannot_be_joined_and_says_so_at_once() {
+fn the_mug_gets_a_voxel_at_each_diagonal_step_and_is_traced() {
     let rules = bricks();
-    let shape = fixture_voxels("mug.obj", 15, &rules);
+    let shape = fixture_voxels("mug.obj", 10, &rules);
+    let opts = backward(1)
+        .with_node_budget(1_000_000)
+        .with_time_budget(std::time::Duration::from_secs(120));
+    let out = search::build(&shape, &rules, &opts).unwrap();
+    let extra = out.repairs.extra_cells;
+    assert!(extra > 0, "the mug's steps are filled");
+    assert_eq!(out.voxels.count(), shape.count() + extra);
+    assert_eq!(out.stats.starts, 1);
+    let asm = Assembly::from_order(&search::placements(&out), rules.layer_ldu(), Color::RED);
+    let report = verify(&asm, Some(&out.voxels));
+    assert!(report.is_ok(), "{report}");
+}
+
+/// The shuttle fixture at 28 studs: its wings are one layer thin, and the
+/// wing's far corner is further from the body than any piece reaches, so
+/// nothing holds it. The trace says so before it starts, not when its
+/// budget ends.
+#[test]
+fn the_shuttle_as_voxelized_cannot_be_joined_and_says_so_at_once() {
+    let rules = bricks();
+    let shape = fixture_voxels("shuttle.obj", 28, &rules);
     let e = search::build(&shape, &rules, &backward(1))
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("the backward search found no derivation: no pieces in the voxels can join the"),
+        e.contains("the backward search found no derivation: no piece can hold the voxel at"),
         "{e}"
     );
     assert!(e.contains("(0 nodes, 0 backtracks"), "{e}");

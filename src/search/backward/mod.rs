@@ -25,7 +25,11 @@
 //! splits, no pieces outside the voxels; every piece fills voxels of the
 //! model only, as in the paper.
 //!
-//! One repair is made first, where pieces stack by more than one layer
+//! Two repairs are made first. Where two voxels meet only along an edge
+//! (a one-voxel ring turning by a diagonal step, a handle climbing by
+//! one), no piece holds them together: a voxel is added at each such step
+//! ([`joinable::fill_steps`]; counted in `extra_cells`, as the layout's
+//! cells there). And where pieces stack by more than one layer
 //! (with slopes, two half-brick layers): a column of voxels that ends half
 //! a course off, where no slope's low row can end it, gets the half course
 //! added ([`courses`]; counted in `evened_voxels`, as the layout's evening
@@ -152,6 +156,9 @@ pub(super) fn build(
     // Parts at least a brick high (a course: 1 layer for bricks, more for
     // slopes or plates).
     let course = (24 / rules.layer_ldu()).max(1);
+    // A wall one voxel thin that turns by diagonal steps gets a voxel at
+    // each step, as the layout gives it a cell there.
+    repairs.extra_cells += joinable::fill_steps(&mut voxels);
     // Every column of voxels ends on a whole course, or where a slope can
     // end it: a half course is added where neither is so (the ridge of a
     // roof of half courses), and a column that still cannot be filled
