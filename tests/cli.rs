@@ -1005,6 +1005,43 @@ fn the_backward_search_builds_the_house_and_writes_its_derivation() {
     assert!(tried > 0 && tried <= nodes / 5 + 1, "{}", report["search"]);
 }
 
+/// A backward build whose derivation does not stand is still built when
+/// the stability stage's other layouts find no derivation: the mug at 8
+/// studs, seed 18, traced in 14,390 nodes, does not stand on its own; the
+/// stage's first other seed (19) needs 18,161 nodes, past the budget of
+/// 15,000, and the next (20) stands. Before, the other seed's "no
+/// derivation" was the build's error (exit 2), though its own seed had
+/// one.
+#[test]
+fn a_backward_build_is_kept_when_another_layouts_trace_finds_nothing() {
+    let tmp = tempdir();
+    let out = tmp.path().join("out");
+    let mug = fixture("mug.obj");
+    let args = [
+        "build",
+        s(&mug),
+        "-o",
+        s(&out),
+        "--studs",
+        "8",
+        "--seed",
+        "18",
+        "--search",
+        "backward",
+        "--node-budget",
+        "15000",
+        "--formats",
+        "ldr",
+        "--quiet",
+    ];
+    run_in(tmp.path(), &args).assert_ok();
+    let report = read_report(&out);
+    let st = &report["stability"];
+    assert_eq!(st["stands"], true, "{st}");
+    let repairs = st["repairs"].to_string();
+    assert!(repairs.contains("kept seed 20's"), "{repairs}");
+}
+
 /// A shape the paper's rules cannot build fails at once with one line
 /// naming the voxel no piece can hold, exit 2, and no files: the shuttle's
 /// wings are one voxel thin at 28 studs and touch the fuselage only at its

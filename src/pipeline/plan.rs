@@ -34,6 +34,9 @@ pub(super) struct Planner<'a> {
     /// [`crate::search::SearchOptions::flat_base`]): the stability
     /// stage's other layouts.
     pub(super) flat_base: Cell<bool>,
+    /// When the search must end, if sooner than its own budget: the
+    /// stability stage's other layouts are searched within its deadline.
+    pub(super) until: Cell<Option<Instant>>,
 }
 
 /// Layouts made again with other seeds when one fails verification.
@@ -59,6 +62,7 @@ impl<'a> Planner<'a> {
             notes: RefCell::new(Vec::new()),
             last_resort: Cell::new(false),
             flat_base: Cell::new(false),
+            until: Cell::new(None),
         }
     }
 
@@ -146,9 +150,7 @@ impl<'a> Planner<'a> {
     fn plan_told(&self, seed: u64, told: bool) -> Result<Plan, BuildError> {
         let started = Instant::now();
         let planned = self.plan_tries(seed, told, started);
-        if !matches!(planned, Err(BuildError::Unverified { .. }))
-            || started.elapsed() >= self.opts.search.time_budget
-        {
+        if !matches!(planned, Err(BuildError::Unverified { .. })) || self.spent(started) {
             return planned;
         }
         self.last_resort.set(true);
@@ -180,7 +182,7 @@ impl<'a> Planner<'a> {
         };
         for k in 0..=RELAYOUTS {
             for &cap in caps {
-                if first_failure.is_some() && started.elapsed() >= self.opts.search.time_budget {
+                if first_failure.is_some() && self.spent(started) {
                     break;
                 }
                 let s = seed.wrapping_add(k * RELAYOUT_STRIDE);
@@ -216,6 +218,13 @@ impl<'a> Planner<'a> {
         self.notes.borrow().clone()
     }
 
+    /// Whether no layout may be begun: the search's time budget since
+    /// `started` is spent, or [`Self::until`] has passed.
+    fn spent(&self, started: Instant) -> bool {
+        started.elapsed() >= self.opts.search.time_budget
+            || self.until.get().is_some_and(|u| Instant::now() >= u)
+    }
+
     /// The search's pieces for `seed`, painted; `told`: how far it is
     /// goes to the progress display; `cap`: stair edges are capped with
     /// slopes (see [`SearchOptions::cap_stairs`]).
@@ -229,9 +238,17 @@ impl<'a> Planner<'a> {
         let model = &self.voxels.model;
         let tell = |done, total| self.progress.advance(done, total);
         let guide = self.guide(told.then_some(&tell as &dyn Fn(u64, u64)));
+        let budget = match self.until.get() {
+            Some(until) => opts
+                .search
+                .time_budget
+                .min(until.saturating_duration_since(Instant::now())),
+            None => opts.search.time_budget,
+        };
         let search_opts = opts
             .search
             .clone()
+            .with_time_budget(budget)
             .with_seed(seed)
             .with_cap_stairs(cap && opts.search.cap_stairs)
             .with_leave_unplaceable(self.last_resort.get())

@@ -288,10 +288,15 @@ pub fn settle(
                 break;
             }
             tried += 1;
-            // A layout that cannot be verified is not a candidate.
+            // A layout that cannot be verified is not a candidate, nor
+            // one the search did not find (a backward trace that ran out
+            // of its budget, which ends by the stage's deadline).
             let planned = match replan(other, flat) {
                 Ok(p) => p,
-                Err(crate::pipeline::BuildError::Unverified { .. }) => continue,
+                Err(
+                    crate::pipeline::BuildError::Unverified { .. }
+                    | crate::pipeline::BuildError::Search { .. },
+                ) => continue,
                 Err(e) => return Err(e),
             };
             // The finished model first: one analysis rules most layouts out.
@@ -1303,6 +1308,16 @@ pub(super) fn stage(
     progress: &dyn crate::pipeline::Progress,
 ) -> Result<Settled, crate::pipeline::BuildError> {
     let tell = |done, total| progress.advance(done, total);
+    // A backward trace for another layout may take the whole search budget
+    // (minutes): it ends by the stage's deadline. The layout's searches
+    // take seconds at most and keep their own budget, so that none is cut
+    // short and leaves voxels out.
+    let until = (opts.search.method == crate::search::Method::Backward).then(|| {
+        Instant::now()
+            + opts
+                .stability_budget
+                .min(Duration::from_secs(1_000_000_000))
+    });
     let ((outcome, assembly, order), report, finished) = settle(
         opts.stability,
         first,
@@ -1312,8 +1327,10 @@ pub(super) fn stage(
         opts.supports,
         &|seed, flat| {
             planner.flat_base.set(flat);
+            planner.until.set(until);
             let planned = planner.plan(seed);
             planner.flat_base.set(false);
+            planner.until.set(None);
             planned
         },
         Some(&tell),
