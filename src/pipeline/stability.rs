@@ -191,9 +191,10 @@ pub struct StabilityReport {
 pub type Plan = (SearchOutcome, Assembly, &'static str);
 
 /// Runs the stage on `plan`. `supports`: the repair may add support
-/// columns. `replan(seed, flat)` searches again with another seed, with no
-/// inverted slope in the lowest course if `flat` (see
-/// [`crate::search::SearchOptions::flat_base`]). `tell` hears
+/// columns. `replan(seed, flat, until)` searches again with another seed,
+/// with no inverted slope in the lowest course if `flat` (see
+/// [`crate::search::SearchOptions::flat_base`]); a backward trace there
+/// ends by `until` (a layout's search keeps its own budget). `tell` hears
 /// how many of the plan's steps the first check has covered, for a
 /// progress display. Returns the plan to write, possibly repaired, and the
 /// report.
@@ -205,7 +206,7 @@ pub fn settle(
     params: &Params,
     budget: Duration,
     supports: bool,
-    replan: &dyn Fn(u64, bool) -> Result<Plan, crate::pipeline::BuildError>,
+    replan: &dyn Fn(u64, bool, Instant) -> Result<Plan, crate::pipeline::BuildError>,
     tell: Option<&dyn Fn(u64, u64)>,
 ) -> Result<(Plan, StabilityReport, Analysis), crate::pipeline::BuildError> {
     // A budget too large for the clock is no budget (about 31 years).
@@ -288,14 +289,18 @@ pub fn settle(
                 break;
             }
             tried += 1;
-            // A layout that cannot be verified is not a candidate, nor
-            // one the search did not find (a backward trace that ran out
-            // of its budget, which ends by the stage's deadline).
-            let planned = match replan(other, flat) {
+            // A layout that cannot be verified is not a candidate, nor a
+            // backward trace that found no derivation: it searches until
+            // there is time left to analyse what it finds.
+            let until = analysis.map_or(deadline, |a| deadline.checked_sub(a).unwrap_or(deadline));
+            let planned = match replan(other, flat, until) {
                 Ok(p) => p,
                 Err(
                     crate::pipeline::BuildError::Unverified { .. }
-                    | crate::pipeline::BuildError::Search { .. },
+                    | crate::pipeline::BuildError::Search {
+                        reason: crate::search::SearchError::Backward { .. },
+                        ..
+                    },
                 ) => continue,
                 Err(e) => return Err(e),
             };
@@ -1312,12 +1317,7 @@ pub(super) fn stage(
     // (minutes): it ends by the stage's deadline. The layout's searches
     // take seconds at most and keep their own budget, so that none is cut
     // short and leaves voxels out.
-    let until = (opts.search.method == crate::search::Method::Backward).then(|| {
-        Instant::now()
-            + opts
-                .stability_budget
-                .min(Duration::from_secs(1_000_000_000))
-    });
+    let backward = opts.search.method == crate::search::Method::Backward;
     let ((outcome, assembly, order), report, finished) = settle(
         opts.stability,
         first,
@@ -1325,9 +1325,9 @@ pub(super) fn stage(
         &Params::default(),
         opts.stability_budget,
         opts.supports,
-        &|seed, flat| {
+        &|seed, flat, until| {
             planner.flat_base.set(flat);
-            planner.until.set(until);
+            planner.until.set(backward.then_some(until));
             let planned = planner.plan(seed);
             planner.flat_base.set(false);
             planner.until.set(None);

@@ -15,7 +15,9 @@
 //! wall turns a corner by a diagonal step, standing on a disc one layer
 //! thick, is such a shape: no piece holds two voxels across an edge, and
 //! every piece under the straight stretch beyond the step reaches under
-//! that stretch alone.
+//! that stretch alone. Such steps are filled before the test
+//! ([`fill_steps`]), so a mug's ring passes it; a sheet one voxel thin
+//! whose far end no piece reaches (a delta wing's) is still refused.
 
 use crate::geom::Cell;
 use crate::grammar::RuleSet;
@@ -222,5 +224,22 @@ mod tests {
         assert_eq!(fill_steps(&mut v), 1);
         assert!(v.get(Cell::new(1, 0, 1)));
         assert_eq!(unjoinable(&v, &bricks()), None);
+        // The same up a step the other way along x and either way along
+        // y: always the cell under the upper voxel.
+        for (dx, dy) in [(-1, 0), (0, 1), (0, -1)] {
+            let mut v = VoxelGrid::new(4, 4, 4);
+            v.set(Cell::new(1, 1, 0), true);
+            v.set(Cell::new(1 + dx, 1 + dy, 1), true);
+            assert_eq!(fill_steps(&mut v), 1, "({dx}, {dy})");
+            assert!(v.get(Cell::new(1 + dx, 1 + dy, 0)), "({dx}, {dy})");
+        }
+        // A diagonal step down in y within a layer (the cells at y - 1),
+        // two voxels alone in it: the two candidates tie, and the one
+        // beside the first voxel along x is taken.
+        let mut v = VoxelGrid::new(4, 4, 1);
+        v.set(Cell::new(1, 2, 0), true);
+        v.set(Cell::new(2, 1, 0), true);
+        assert_eq!(fill_steps(&mut v), 1);
+        assert!(v.get(Cell::new(2, 2, 0)));
     }
 }
