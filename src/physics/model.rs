@@ -415,6 +415,11 @@ fn stopped(s: &Structure) -> bool {
         .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
 }
 
+/// Whether `deadline` has passed.
+pub(super) fn past(deadline: Option<std::time::Instant>) -> bool {
+    deadline.is_some_and(|d| std::time::Instant::now() >= d)
+}
+
 /// Which of [`solve_until`]'s two programs is solved first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum First {
@@ -463,7 +468,7 @@ pub(super) fn solve_until(
         until,
         ..Method::DEFAULT
     };
-    let late = || stopped(s) || until.is_some_and(|d| std::time::Instant::now() >= d);
+    let late = || stopped(s) || past(until);
     let within = || {
         let held = Props {
             props: &[],
@@ -675,8 +680,7 @@ pub(super) fn solve_by(
                 p.total.fetch_add(1, Relaxed);
                 p.current.store(info.iterations, Relaxed);
             }
-            stop.as_ref().is_some_and(|f| f.load(Relaxed))
-                || until.is_some_and(|d| std::time::Instant::now() >= d)
+            stop.as_ref().is_some_and(|f| f.load(Relaxed)) || past(until)
         });
     }
     solver.solve();

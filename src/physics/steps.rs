@@ -13,7 +13,7 @@ use crate::assembly::Assembly;
 use super::certify::{Certifier, Verdict};
 use super::compression;
 use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
-use super::model::{solve_until, Contact, First, Structure};
+use super::model::{past, solve_until, Contact, First, Structure};
 use super::{
     weakest, Analysis, Params, Pending, PhysicsError, PieceStress, StepCheck, StepsAnalysis,
     StressMap,
@@ -90,11 +90,6 @@ enum Finishing {
     After,
     /// Alongside it, since the time given.
     Alongside,
-}
-
-/// Whether `deadline` has passed.
-fn past(deadline: Option<Instant>) -> bool {
-    deadline.is_some_and(|d| Instant::now() >= d)
 }
 
 /// Solves the jobs in parallel, in order: each job's stress per piece,

@@ -36,7 +36,7 @@ use std::collections::{HashMap, HashSet};
 
 use serde::Serialize;
 
-use super::model::{solve_propped, First, Prop, Props, Structure};
+use super::model::{past, solve_propped, First, Prop, Props, Structure};
 use super::{analyze_by, Params, PhysicsError};
 use crate::assembly::verify::{verify, Failure};
 use crate::assembly::{Assembly, Placed, Placement, Step, MAX_STEPS, STEP_MIN_PIECES, STEP_PIECES};
@@ -271,11 +271,6 @@ pub fn shore_up(
         stands,
         solves,
     }))
-}
-
-/// Whether `deadline` has passed.
-fn past(deadline: Option<std::time::Instant>) -> bool {
-    deadline.is_some_and(|d| std::time::Instant::now() >= d)
 }
 
 /// The columns of `chosen` (as `(x, y, bottom)`) that make `asm` fail

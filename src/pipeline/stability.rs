@@ -292,7 +292,9 @@ pub fn settle(
             // A layout that cannot be verified is not a candidate, nor a
             // backward trace that found no derivation: it searches until
             // there is time left to analyse what it finds.
-            let until = analysis.map_or(deadline, |a| deadline.checked_sub(a).unwrap_or(deadline));
+            let until = analysis
+                .and_then(|a| deadline.checked_sub(a))
+                .unwrap_or(deadline);
             let planned = match replan(other, flat, until) {
                 Ok(p) => p,
                 Err(
