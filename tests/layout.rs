@@ -212,6 +212,19 @@ fn a_thin_fin_touching_at_its_edges_is_built_whole() {
     }
 }
 
+/// A loose body that meets the rest only through slopes: the wedge at 13
+/// studs with slopes and plates had one (its pieces beside the rest were
+/// slopes, which the repair that lays two pieces again across them passed
+/// over), and 8 voxels were left out on seeds 1 and 2.
+#[test]
+fn a_body_held_apart_by_its_slopes_is_joined() {
+    let r = rules(true, true);
+    for seed in [1, 2] {
+        // `checked` asserts every voxel built.
+        build_fixture("wedge.stl", 13, &r, seed);
+    }
+}
+
 /// A standing ring one voxel thick: its sides climb diagonally, its top
 /// hangs over the hole.
 #[test]

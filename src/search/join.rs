@@ -22,6 +22,10 @@ use crate::geom::{Body, Cell};
 /// Rounds of repairs before what is still apart is left out.
 const ROUNDS: usize = 8;
 
+/// Pieces across a slope and its neighbour tried, best first, before the
+/// pair is given up ([`Layout::retile_pair`]).
+const ACROSS_TRIES: usize = 6;
+
 /// How two pieces of a retile meet: side by side, or only at a corner.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Meet {
@@ -216,12 +220,34 @@ impl Layout<'_> {
         let roots: Vec<u32> = (0..self.pieces.len() as u32)
             .map(|i| self.uf.find(i))
             .collect();
+        // The body's bricks and plates first; then its slopes (a thin ear's
+        // tip may be two slopes one over the other, beside the rest), laid
+        // again with a piece that may fill the cells the surface passes
+        // through, where the slope's face was.
+        for slopes in [false, true] {
+            if self.retile_pieces(body, root, &roots, rng, (meet, slopes)) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// [`Layout::retile_across`] for the pieces of `body` that are slopes
+    /// (`slopes`) or are not.
+    fn retile_pieces(
+        &mut self,
+        body: &[u32],
+        root: u32,
+        roots: &[u32],
+        rng: &mut impl rand::Rng,
+        (meet, slopes): (Meet, bool),
+    ) -> bool {
         let mut tries = 0;
         for &h in body {
             let hb = self.pieces[h as usize].body;
             // A piece an earlier repair of this round took out is gone.
             if self.pieces[h as usize].gone
-                || self.pieces[h as usize].placement.part.spec().shape != Shape::Rect
+                || (self.pieces[h as usize].placement.part.spec().shape != Shape::Rect) != slopes
             {
                 continue;
             }
@@ -253,7 +279,7 @@ impl Layout<'_> {
                 if tries > 64 {
                     return false;
                 }
-                if self.retile_pair((h, w), (root, &roots), rng, meet) {
+                if self.retile_pair((h, w), (root, roots), rng, (meet, slopes)) {
                     return true;
                 }
             }
@@ -262,13 +288,18 @@ impl Layout<'_> {
     }
 
     /// [`Layout::retile_across`] for pieces `h` (of the body `root`, whose
-    /// pieces' roots before the repair are `roots`) and `w`.
+    /// pieces' roots before the repair are `roots`) and `w`. With `slopes`
+    /// (`h` is a slope), the piece across may fill cells the
+    /// surface passes through (where the slope's face was), and the
+    /// pieces across are tried best first, [`ACROSS_TRIES`] of them: the
+    /// best may cover the cells of the two and join neither body to the
+    /// other, where the slope alone held the pieces over it.
     fn retile_pair(
         &mut self,
         (h, w): (u32, u32),
         (root, roots): (u32, &[u32]),
         rng: &mut impl rand::Rng,
-        meet: Meet,
+        (meet, slopes): (Meet, bool),
     ) -> bool {
         let (hp, wp) = (self.pieces[h as usize], self.pieces[w as usize]);
         let cells: Vec<Cell> = hp
@@ -277,43 +308,66 @@ impl Layout<'_> {
             .chain(wp.body.cells())
             .filter(|&q| self.must.get(q))
             .collect();
-        let first_new = self.pieces.len() as u32;
-        let extra_before = self.repairs.extra_cells;
         self.remove(h);
         self.remove(w);
-        let ok = match self.across(&hp.body, &wp.body, meet) {
-            Some((p, b)) => {
-                // Cells outside the model: only where the two meet at a
-                // corner.
-                self.repairs.extra_cells += b.cells().filter(|&q| !self.must.get(q)).count();
-                self.place(p, b, None);
-                for &c in &cells {
-                    if self.owner_of(c).is_none() {
-                        if let Some(cand) = self.choose(c, rng) {
-                            self.repairs.extra_cells += cand.extra;
-                            self.place(cand.placement, cand.body, None);
-                        }
-                    }
-                }
-                let covered = cells.iter().all(|&c| self.owner_of(c).is_some());
-                self.rebuild_bodies();
-                let r = self.uf.find(first_new);
-                let alone = roots.iter().filter(|&&x| x == root).count() == 1;
-                let (mut mine, mut other) = (alone, false);
-                for i in 0..first_new {
-                    if self.pieces[i as usize].gone || self.uf.find(i) != r {
-                        continue;
-                    }
-                    if roots[i as usize] == root {
-                        mine = true;
-                    } else {
-                        other = true;
-                    }
-                }
-                covered && mine && other
+        let loose = meet == Meet::Corner || slopes;
+        let tries = if slopes { ACROSS_TRIES } else { 1 };
+        for (p, b) in self
+            .across(&hp.body, &wp.body, loose)
+            .into_iter()
+            .take(tries)
+        {
+            if self.lay_across((p, b), &cells, (root, roots), rng) {
+                return true;
             }
-            None => false,
-        };
+        }
+        self.restore(h);
+        self.restore(w);
+        self.rebuild_bodies();
+        false
+    }
+
+    /// Lays the piece `p` (body `b`) across two pieces taken out, and the
+    /// rest of their `cells` as the layout would; kept if the cells are
+    /// covered and the new pieces join the body `root` to another (whose
+    /// pieces' roots before the repair are `roots`), else undone.
+    fn lay_across(
+        &mut self,
+        (p, b): (Placement, Body),
+        cells: &[Cell],
+        (root, roots): (u32, &[u32]),
+        rng: &mut impl rand::Rng,
+    ) -> bool {
+        let first_new = self.pieces.len() as u32;
+        let extra_before = self.repairs.extra_cells;
+        // Cells outside the model: only where the two meet at a corner, or
+        // where a slope's face was.
+        self.repairs.extra_cells += b.cells().filter(|&q| !self.must.get(q)).count();
+        self.place(p, b, None);
+        for &c in cells {
+            if self.owner_of(c).is_none() {
+                if let Some(cand) = self.choose(c, rng) {
+                    self.repairs.extra_cells += cand.extra;
+                    self.place(cand.placement, cand.body, None);
+                }
+            }
+        }
+        let covered = cells.iter().all(|&c| self.owner_of(c).is_some());
+        self.rebuild_bodies();
+        let r = self.uf.find(first_new);
+        let alone = roots.iter().filter(|&&x| x == root).count() == 1;
+        let (mut mine, mut other) = (alone, false);
+        for i in 0..first_new {
+            if self.pieces[i as usize].gone || self.uf.find(i) != r {
+                continue;
+            }
+            if roots[i as usize] == root {
+                mine = true;
+            } else {
+                other = true;
+            }
+        }
+        let ok = covered && mine && other;
         if !ok {
             for i in first_new..self.pieces.len() as u32 {
                 if !self.pieces[i as usize].gone {
@@ -321,21 +375,20 @@ impl Layout<'_> {
                 }
             }
             self.repairs.extra_cells = extra_before;
-            self.restore(h);
-            self.restore(w);
             self.rebuild_bodies();
         }
         ok
     }
 
-    /// The biggest brick (or plate) over the model's free voxels in the
-    /// layers `a` and `b` share that reaches into the boxes of both; where
-    /// they meet at a corner, over the cells the surface passes through
-    /// too, the fewest of those first.
-    fn across(&self, a: &Body, b: &Body, meet: Meet) -> Option<(Placement, Body)> {
+    /// The bricks (and plates) over the model's free voxels in the layers
+    /// `a` and `b` share that reach into the boxes of both, the biggest
+    /// first; `loose` (where they meet at a corner, or one is a slope),
+    /// over the cells the surface passes through too, the fewest of those
+    /// first.
+    fn across(&self, a: &Body, b: &Body, loose: bool) -> Vec<(Placement, Body)> {
         // Ranked by (fewest cells outside, most cells): all inside side by
         // side.
-        let mut best: Option<((i32, i32), Placement, Body)> = None;
+        let mut found: Vec<((i32, i32), Placement, Body)> = Vec::new();
         let ab = a.bbox;
         let lo = ab.min.z.max(b.bbox.min.z);
         let hi = (ab.min.z + ab.sz).min(b.bbox.min.z + b.bbox.sz);
@@ -353,29 +406,25 @@ impl Layout<'_> {
                         if !body.bbox.intersects(&ab) || !body.bbox.intersects(&b.bbox) {
                             continue;
                         }
-                        let v = match meet {
-                            Meet::Side
-                                if body.cells().all(|q| self.must.get(q) && self.free(q)) =>
-                            {
-                                (0, body.volume())
+                        let v = if loose {
+                            let placement = Placement::new(shape.part, origin, shape.rot);
+                            match self.fits(&placement, &body, Reach::Near) {
+                                Some((inside, near, 0)) => (-(near as i32), inside as i32),
+                                _ => continue,
                             }
-                            Meet::Corner => {
-                                let placement = Placement::new(shape.part, origin, shape.rot);
-                                match self.fits(&placement, &body, Reach::Near) {
-                                    Some((inside, near, 0)) => (-(near as i32), inside as i32),
-                                    _ => continue,
-                                }
-                            }
-                            Meet::Side => continue,
+                        } else if body.cells().all(|q| self.must.get(q) && self.free(q)) {
+                            (0, body.volume())
+                        } else {
+                            continue;
                         };
-                        if best.as_ref().is_none_or(|x| v > x.0) {
-                            best = Some((v, Placement::new(shape.part, origin, shape.rot), body));
-                        }
+                        found.push((v, Placement::new(shape.part, origin, shape.rot), body));
                     }
                 }
             }
         }
-        best.map(|(_, p, b)| (p, b))
+        // Best first; of equal ones, the first found.
+        found.sort_by_key(|x| std::cmp::Reverse(x.0));
+        found.into_iter().map(|(_, p, b)| (p, b)).collect()
     }
 
     /// Fills the gaps between piece `p` and the pieces under it and over
