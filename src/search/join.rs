@@ -289,11 +289,11 @@ impl Layout<'_> {
 
     /// [`Layout::retile_across`] for pieces `h` (of the body `root`, whose
     /// pieces' roots before the repair are `roots`) and `w`. With `slopes`
-    /// (`h` is a slope), the piece across may fill cells the
-    /// surface passes through (where the slope's face was), and the
-    /// pieces across are tried best first, [`ACROSS_TRIES`] of them: the
-    /// best may cover the cells of the two and join neither body to the
-    /// other, where the slope alone held the pieces over it.
+    /// (`h` is a slope), the piece across may fill cells the surface
+    /// passes through (where the slope's face was), and the pieces across
+    /// are tried best first, [`ACROSS_TRIES`] of them: the best may cover
+    /// the cells of the two and join neither body to the other, where the
+    /// slope alone held the pieces over it.
     fn retile_pair(
         &mut self,
         (h, w): (u32, u32),
