@@ -225,6 +225,32 @@ fn a_body_held_apart_by_its_slopes_is_joined() {
     }
 }
 
+/// A flat shape one voxel high (a glider at 4 studs is one): its sheet is
+/// made two courses thick like any other, so its bricks hold together;
+/// the grid had no layer over it to grow into, and voxels were left out.
+#[test]
+fn a_shape_one_layer_high_is_built_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("flat.obj");
+    // An L of two plates-thin slabs, 0.3 units high on 5 x 5 units.
+    let slab = |x0: f64, z0: f64, x1: f64, z1: f64| {
+        (
+            [(x0, z0, 0.0), (x1, z0, 0.0), (x1, z1, 0.0), (x0, z1, 0.0)],
+            0.3,
+        )
+    };
+    std::fs::write(
+        &path,
+        common::prisms(&[slab(0.0, 0.0, 5.0, 2.0), slab(0.0, 2.0, 2.0, 5.0)]),
+    )
+    .unwrap();
+    for (slopes, plates) in [(false, false), (true, false), (false, true)] {
+        // `checked` asserts every voxel built.
+        let b = build_mesh(&path, 5, &rules(slopes, plates), 1);
+        assert!(b.out.repairs.thickened_voxels > 0);
+    }
+}
+
 /// A standing ring one voxel thick: its sides climb diagonally, its top
 /// hangs over the hole.
 #[test]

@@ -379,8 +379,13 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
     let origin = lo - (cells * cell - ext) * 0.5;
     // Room on top for whole brick courses: a grid of half-brick layers
     // gets an empty layer over an odd count, so a flat top can be evened up.
+    // And room for a sheet to be made two courses thick (with plates, two
+    // plates, which a course of three holds): a flat shape one layer high
+    // (a glider at 4 studs) had no layer to grow into, and its bricks side
+    // by side fell apart into pieces left out.
     let course = (24 / opts.layer_ldu.clamp(1, 24)) as u64;
-    let nz = nz.div_ceil(course) * course;
+    let least = if course == 3 { course } else { 2 * course };
+    let nz = (nz.div_ceil(course) * course).max(least);
     let dims = [nx as usize, ny as usize, nz as usize];
     let scaled: Vec<[DVec3; 3]> = tris
         .iter()
@@ -1028,10 +1033,12 @@ mod tests {
         };
         let e = voxelize(&flat, &z_up(Sizing::Height(3))).unwrap_err();
         assert!(matches!(e, VoxelizeError::Flat { .. }), "{e}");
-        // Sized by studs, a flat sheet is one layer.
+        // Sized by studs, a flat sheet is one layer, in a grid with room
+        // over it to be made two layers thick.
         let v = voxelize(&flat, &z_up(Sizing::Studs(4))).unwrap();
-        assert_eq!(v.grid.dims().2, 1);
-        assert!(v.grid.count() >= 4);
+        assert_eq!(v.grid.dims().2, 2);
+        assert!(v.grid.count_layer(0) >= 4);
+        assert_eq!(v.grid.count_layer(1), 0);
         let mut bad = flat.clone();
         bad.triangles[0][1] = 9;
         assert!(matches!(
