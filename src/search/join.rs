@@ -312,11 +312,16 @@ impl Layout<'_> {
         self.remove(w);
         let loose = meet == Meet::Corner || slopes;
         let tries = if slopes { ACROSS_TRIES } else { 1 };
-        for (p, b) in self
+        for (k, (p, b)) in self
             .across(&hp.body, &wp.body, loose)
             .into_iter()
             .take(tries)
+            .enumerate()
         {
+            // The bodies again without what the last try laid.
+            if k > 0 {
+                self.rebuild_bodies();
+            }
             if self.lay_across((p, b), &cells, (root, roots), rng) {
                 return true;
             }
@@ -330,7 +335,8 @@ impl Layout<'_> {
     /// Lays the piece `p` (body `b`) across two pieces taken out, and the
     /// rest of their `cells` as the layout would; kept if the cells are
     /// covered and the new pieces join the body `root` to another (whose
-    /// pieces' roots before the repair are `roots`), else undone.
+    /// pieces' roots before the repair are `roots`), else undone (the
+    /// bodies are then not rebuilt).
     fn lay_across(
         &mut self,
         (p, b): (Placement, Body),
@@ -375,7 +381,6 @@ impl Layout<'_> {
                 }
             }
             self.repairs.extra_cells = extra_before;
-            self.rebuild_bodies();
         }
         ok
     }

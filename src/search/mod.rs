@@ -419,7 +419,7 @@ pub fn build_guided(
     // two layers laminate.
     let course = 24 / rules.layer_ldu();
     let plates = rules.layer_ldu() == 8;
-    let min_thick = if plates { 2 } else { 2 * course };
+    let min_thick = crate::voxel::voxelize::sheet_layers(rules.layer_ldu());
     prepare::thicken_sheets(&mut fixed, &mut repairs, min_thick);
     if !plates {
         prepare::even_courses(&mut fixed, guide.slant, course, &mut repairs);

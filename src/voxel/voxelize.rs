@@ -333,6 +333,18 @@ pub fn to_grid_frame(p: Vec3, up: Up) -> Vec3 {
     }
 }
 
+/// The fewest layers of `layer_ldu` a sheet of voxels must be to hold
+/// together: two courses of bricks (pieces side by side in one course do
+/// not hold each other), or two plates, which laminate.
+pub fn sheet_layers(layer_ldu: i32) -> i32 {
+    let course = 24 / layer_ldu.clamp(1, 24);
+    if layer_ldu == 8 {
+        2
+    } else {
+        2 * course
+    }
+}
+
 /// Fills the cells whose centres lie inside `mesh`, plus the cells needed to
 /// keep thin parts (see the module docs).
 pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, VoxelizeError> {
@@ -384,7 +396,7 @@ pub fn voxelize(mesh: &Mesh, opts: &VoxelizeOptions) -> Result<VoxelModel, Voxel
     // (a glider at 4 studs) had no layer to grow into, and its bricks side
     // by side fell apart into pieces left out.
     let course = (24 / opts.layer_ldu.clamp(1, 24)) as u64;
-    let least = if course == 3 { course } else { 2 * course };
+    let least = (sheet_layers(opts.layer_ldu) as u64).div_ceil(course) * course;
     let nz = (nz.div_ceil(course) * course).max(least);
     let dims = [nx as usize, ny as usize, nz as usize];
     let scaled: Vec<[DVec3; 3]> = tris
