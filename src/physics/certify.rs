@@ -848,6 +848,36 @@ mod tests {
     }
 
     #[test]
+    fn a_new_pieces_way_down_follows_its_plumb_line() {
+        use crate::assembly::{Assembly, Placement};
+        use crate::catalog::{Color, PartKind};
+        use crate::geom::{Cell, Rot};
+        let at = |id: &str, x, z| {
+            Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0)
+        };
+        // Two stacks of 1 x 2 bricks, at x 0 and x 4, bridged by a 1 x 6,
+        // and a 1 x 2 on the bridge over the first stack. Lowest first,
+        // the way went down the stack placed first, the far one; the
+        // plumb line of the new piece is over the near one.
+        let order = [
+            at("3004", 0, 0),
+            at("3004", 4, 0),
+            at("3004", 4, 1),
+            at("3004", 0, 1),
+            at("3009", 0, 2),
+            at("3004", 0, 3),
+        ];
+        let asm = Assembly::from_order(&order, 24, Color::RED);
+        let params = Params::default();
+        let s = Structure::new(&asm, &params);
+        let mut cert = Certifier::new(&s, &params);
+        cert.place_to(order.len());
+        assert_eq!(cert.way_down(5), vec![0, 3, 4, 5]);
+        // Scratch marks are left clean.
+        assert!(cert.local.iter().all(|&l| l == u32::MAX));
+    }
+
+    #[test]
     fn a_regions_program_past_the_deadline_gives_no_answer() {
         // In time (or with no deadline), the clutch is found.
         let later = std::time::Instant::now() + std::time::Duration::from_secs(3600);
