@@ -9,9 +9,10 @@
 //!
 //! The check keeps the equilibrium found for the step before. A step adds
 //! pieces; their weight must be carried, and only the forces near them
-//! need change: the change is looked for among the new pieces, a way down
-//! from each to the ground (near its plumb line) and ways to the group's outermost grounded
-//! pieces (a weight anywhere shifts the reactions under the whole group:
+//! need change: the change is looked for among the new pieces, ways down
+//! from each to the ground (near its plumb line, and lowest first) and
+//! ways to the group's outermost grounded pieces (a weight anywhere
+//! shifts the reactions under the whole group:
 //! a head held out by a support column at its far side needs that
 //! column's way down), as a small linear program whose unknowns are the
 //! changes to those forces (the contacts among those pieces and their
@@ -364,10 +365,12 @@ impl<'a> Certifier<'a> {
         let mut footing = Vec::new();
         if near {
             // The new weight leaves the region only through its grounds:
-            // the region holds a way down to the ground from each new
-            // piece.
+            // the region holds ways down to the ground from each new
+            // piece, one near its plumb line and one lowest first.
             for i in 0..new.len() {
-                let way = self.way_down(new[i]);
+                let way = self.way_down(new[i], true);
+                new.extend(way);
+                let way = self.way_down(new[i], false);
                 new.extend(way);
             }
             // A weight anywhere shifts the whole group's ground reactions:
@@ -417,28 +420,37 @@ impl<'a> Certifier<'a> {
     }
 
     /// The pieces on a way through contacts from piece `from` down to a
-    /// piece on the ground, as near its plumb line as there is one: at
-    /// each turn the piece whose extent comes nearest the line through
-    /// `from`'s centre of mass (then the lowest); empty if none.
+    /// piece on the ground; empty if none. Lowest first at each turn, or
+    /// with `plumb`, as near `from`'s plumb line as there is one: the
+    /// piece whose extent comes nearest the line through its centre of
+    /// mass first, then the lowest.
     ///
     /// The way carries the new piece's weight, and every piece on it must
-    /// balance it: a way that leaves the line must carry the weight's
-    /// moment about it through its joints, and where it ends on a
-    /// footing away from the line (the ground pushes only, under that
-    /// piece) the region may hold no change. On the bunny at 72 studs
-    /// (5,003 pieces with its support columns), with the lowest-first way
-    /// of before (down wherever the ground came soonest), the first
-    /// region held the step's weight in 72 of 213 steps of the last
-    /// support round's check (the rest widened to regions of 580 and
-    /// then 1,050 pieces: 78 s of programs); down the plumb line, in 182
-    /// of 225 (first regions of 350 pieces: 30 s in all).
-    fn way_down(&mut self, from: usize) -> Vec<usize> {
+    /// balance it: a way that leaves the line carries the weight's moment
+    /// about it through its joints, and where it ends on a footing away
+    /// from the line (the ground pushes only, under that piece) the
+    /// region may hold no change; the lowest-first way reaches the ground
+    /// soonest, which is where the structure sends its weight around an
+    /// overhang. The first region holds both. Measured on the last
+    /// support round's check of the bunny at 72 studs (5,003 pieces with
+    /// its columns): lowest first alone, the first region held the
+    /// step's weight in 72 of 213 steps (the rest widened to regions of
+    /// 580 and then 1,050 pieces: 78 s of programs); the plumb line alone,
+    /// in 182 of 225 (first regions of 350 pieces: 30 s in all), but on
+    /// suzanne at 80 studs it left 8 steps to the whole group's program
+    /// where lowest first left 2 (the stage 47 s, was 36 s); both, 3
+    /// steps and 26 s (fandisk at 64 studs: 71 s, plumb line 53 s,
+    /// both 32 s).
+    fn way_down(&mut self, from: usize, plumb: bool) -> Vec<usize> {
         use std::cmp::Reverse;
         let s = self.s;
         let (x, y) = s.loads[from].com;
         // How far a piece's extent is from the plumb line, in
         // thousandths of a stud (a whole number, to order by).
         let off = |q: usize| -> i64 {
+            if !plumb {
+                return 0;
+            }
             let e = &s.loads[q].extent;
             let dx = (e.x0 - x).max(x - e.x1).max(0.0);
             let dy = (e.y0 - y).max(y - e.y1).max(0.0);
@@ -857,7 +869,7 @@ mod tests {
         };
         // Two stacks of 1 x 2 bricks, at x 0 and x 4, bridged by a 1 x 6,
         // and a 1 x 2 on the bridge over the first stack. Lowest first,
-        // the way went down the stack placed first, the far one; the
+        // the way goes down the stack placed first, the far one; the
         // plumb line of the new piece is over the near one.
         let order = [
             at("3004", 0, 0),
@@ -872,7 +884,8 @@ mod tests {
         let s = Structure::new(&asm, &params);
         let mut cert = Certifier::new(&s, &params);
         cert.place_to(order.len());
-        assert_eq!(cert.way_down(5), vec![0, 3, 4, 5]);
+        assert_eq!(cert.way_down(5, true), vec![0, 3, 4, 5]);
+        assert_eq!(cert.way_down(5, false), vec![1, 2, 4, 5]);
         // Scratch marks are left clean.
         assert!(cert.local.iter().all(|&l| l == u32::MAX));
     }
