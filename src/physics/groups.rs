@@ -211,11 +211,3 @@ fn grow_groups(
     *reused += groups - touched.len();
     touched
 }
-
-/// Whether every piece a job adds (from `begin` on) rests straight down
-/// on the ground through the first `end` pieces.
-pub(super) fn drops(s: &Structure, job: &Job, begin: usize, end: usize) -> bool {
-    job.pieces
-        .iter()
-        .all(|&p| p < begin || s.drops_straight(p, end))
-}

@@ -194,35 +194,6 @@ impl Structure {
         }
     }
 
-    /// Whether the weight of `piece` can go straight down to the ground in
-    /// compression through the first `end` pieces: its centre of mass lies
-    /// in a face it rests on, that point in a face the piece below rests
-    /// on, and so on down to the ground. Adding such a piece to a standing
-    /// structure leaves every other force as it was (compression only
-    /// grows, exactly under the new load), so the structure still stands
-    /// with the same clutch usage: a certificate without solving.
-    pub fn drops_straight(&self, piece: usize, end: usize) -> bool {
-        let (x, y) = self.loads[piece].com;
-        let inside = |r: &Rect| {
-            const EPS: f64 = 1e-9;
-            r.x0 - EPS <= x && x <= r.x1 + EPS && r.y0 - EPS <= y && y <= r.y1 + EPS
-        };
-        let mut p = piece;
-        loop {
-            if self.loads[p].ground.as_ref().is_some_and(inside) {
-                return true;
-            }
-            let next = self.under[p]
-                .iter()
-                .map(|&k| &self.contacts[k])
-                .find(|c| c.below < end && c.face.as_ref().is_some_and(inside));
-            match next {
-                Some(c) => p = c.below,
-                None => return false,
-            }
-        }
-    }
-
     /// Whether the piece rests on the ground.
     pub fn grounded(&self, piece: usize) -> bool {
         self.loads[piece].ground.is_some()

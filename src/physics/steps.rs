@@ -12,7 +12,7 @@ use crate::assembly::Assembly;
 
 use super::certify::{Certifier, Verdict};
 use super::compression;
-use super::groups::{drops, jobs_for_step, Groups, Job, JobWindow};
+use super::groups::{jobs_for_step, Groups, Job, JobWindow};
 use super::model::{past, solve_until, Contact, First, Structure};
 use super::{
     weakest, Analysis, Params, Pending, PhysicsError, PieceStress, StepCheck, StepsAnalysis,
@@ -765,10 +765,11 @@ fn check_steps_in(
                 .pieces
                 .iter()
                 .all(|&p| p >= begin || !current[p].fails());
-            if job.grounded && stood && drops(s, job, begin, end) {
-                for &p in job.pieces.iter().filter(|&&p| p >= begin) {
+            let fresh: Vec<usize> = job.pieces.iter().copied().filter(|&p| p >= begin).collect();
+            if job.grounded && stood && cert.spread_down(&fresh, true).is_some() {
+                // Straight down in pushes alone: no clutch used anew.
+                for &p in &fresh {
                     current[p] = PieceStress::resting();
-                    cert.drop_straight(p, end);
                 }
                 // It stands, but its answer need not be the program's.
                 for &p in &job.pieces {

@@ -448,7 +448,7 @@ pub fn settle(
     let stress_map = map_finished(
         &mut best.check,
         (&mut best.finished, &mut best.pending),
-        &best.plan.1,
+        (&best.plan.1, MAP_PIECES),
         params,
         deadline,
         &mut counts,
@@ -875,12 +875,13 @@ fn check_the_rest(
 /// Gives `check`, complete, of `assembly`, the finished model's map from
 /// the force program, once: `finished` when made already, else the one
 /// `pending` (started now if none is), if it ends by `deadline` (then
-/// kept in `finished`); else the map stays the certificates'. Returns
-/// where the map comes from.
+/// kept in `finished`); else the map stays the certificates', and so it
+/// does for a model of more than `most` pieces (see [`MAP_PIECES`]: the
+/// program being made is dropped). Returns where the map comes from.
 fn map_finished(
     check: &mut StepsAnalysis,
     (finished, pending): (&mut Option<Analysis>, &mut Option<Pending>),
-    assembly: &Assembly,
+    (assembly, most): (&Assembly, usize),
     params: &Params,
     deadline: Instant,
     counts: &mut Counts,
@@ -888,6 +889,10 @@ fn map_finished(
     let n = assembly.pieces.len();
     if check.map == StressMap::Program || check.last.pieces.len() != n {
         return Ok(check.map);
+    }
+    if n > most {
+        *pending = None;
+        return Ok(StressMap::Certificates);
     }
     let made = match finished {
         Some(f) => f,
@@ -921,6 +926,15 @@ fn map_finished(
     }
     Ok(StressMap::Program)
 }
+
+/// Pieces past which the finished model's map is drawn from the
+/// certificates, its program not solved for it: the program grows as
+/// about the 2.4th power of the pieces of its biggest group (on one core,
+/// the bunny at 48 studs, 1,681 pieces, 2.9 s; at 64, 3,621 pieces, 21 s;
+/// at 72, 5,025 pieces, 83 s), past what the whole stage's check takes
+/// (the bunny at 72 studs about 30 s), for a picture. A size, not a
+/// clock, so that the same build always draws the same map.
+const MAP_PIECES: usize = 3_000;
 
 /// The columns' footprints in words: "3 of 2 x 2, 1 of 1 x 1".
 fn sizes(columns: &[Column]) -> String {
@@ -1007,7 +1021,8 @@ fn support(
         // them needs no more of its own).
         let from = first_change(asm, &shored.assembly);
         best.pending = None;
-        let job = Pending::start(&shored.assembly, params);
+        let job = (shored.assembly.pieces.len() <= MAP_PIECES)
+            .then(|| Pending::start(&shored.assembly, params));
         let mut c = analyze_steps_verdicts(
             &shored.assembly,
             params,
@@ -1015,7 +1030,7 @@ fn support(
             Some(deadline),
             from,
             None,
-            Finish::Pending(&job),
+            job.as_ref().map_or(Finish::WhenDue, Finish::Pending),
         )?;
         counts.add(&c);
         // Out of time part way: the columns are still kept if the steps
@@ -1045,7 +1060,7 @@ fn support(
             plan: (best.plan.0.clone(), shored.assembly, best.plan.2),
             check: spliced(&best.check, from, c),
             partial,
-            pending: finished.is_none().then_some(job),
+            pending: job.filter(|_| finished.is_none()),
             finished,
             order_fix,
             order_tried: best.order_tried,
@@ -1359,7 +1374,7 @@ mod tests {
     use crate::physics::fixtures::counterweighted;
 
     #[test]
-    fn the_finished_models_map_is_the_programs_once_or_the_certificates_past_the_budget() {
+    fn the_finished_models_map_is_the_programs_once_or_the_certificates_past_the_budget_or_size() {
         let params = Params::default();
         let asm = counterweighted();
         let whole = analyze(&asm, &params).unwrap();
@@ -1379,7 +1394,14 @@ mod tests {
                     pending: &mut Option<Pending>,
                     deadline: Instant,
                     counts: &mut Counts| {
-            map_finished(check, (finished, pending), &asm, &params, deadline, counts)
+            map_finished(
+                check,
+                (finished, pending),
+                (&asm, 100),
+                &params,
+                deadline,
+                counts,
+            )
         };
         // Past the deadline, with no program being made: the map stays
         // the certificates', and no program is solved.
@@ -1397,6 +1419,21 @@ mod tests {
             (certified.last.pieces, 0)
         );
         assert!(finished.is_none());
+        // A model past the size given: the certificates' map, the program
+        // being made dropped, even in time.
+        let mut pending = Some(Pending::start(&asm, &params));
+        let (mut check, mut counts) = (verdicts(), Counts::default());
+        let drawn = map_finished(
+            &mut check,
+            (&mut None, &mut pending),
+            (&asm, asm.pieces.len() - 1),
+            &params,
+            later,
+            &mut counts,
+        );
+        assert_eq!(drawn.unwrap(), StressMap::Certificates);
+        assert!(pending.is_none() && counts.solves == 0);
+        assert_eq!(check.last.pieces.len(), asm.pieces.len());
         // In time: the program's map, solved once (on a thread of its own,
         // started here or before), kept for the next asker.
         for mut pending in [None, Some(Pending::start(&asm, &params))] {
