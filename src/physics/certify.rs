@@ -306,10 +306,10 @@ impl<'a> Certifier<'a> {
     /// passes them on to the faces under it (and its ground) at that
     /// point, where one face holds it, else shared among three of their
     /// corners whose triangle holds it (with `straight`, only on a face
-    /// that holds it: the weight goes straight down). False, changing
-    /// nothing, where a piece's resultant lies outside every such triangle
-    /// (only a pull at its studs could hold it: an overhang, for a
-    /// program). Returns the pushes added (force, amount). Compression
+    /// that holds it: the weight goes straight down). The pushes added
+    /// (force, amount); none, changing nothing, where a piece's resultant
+    /// lies outside every such triangle (only a pull at its studs could
+    /// hold it: an overhang, for a program). Compression
     /// only grows, so every other force stays within its bounds and every
     /// piece's clutch used stays as it was; each piece the loads pass
     /// through is checked balanced.
