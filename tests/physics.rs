@@ -278,6 +278,47 @@ fn an_overhang_falls_when_built_before_its_counterweight() {
     assert!(close(got, want, 0.01), "{got} vs {want}");
 }
 
+/// The overhang of [`overhang`] built first, two 1x2s stacked on its far
+/// end (x 7..9), then a counterweight of 1x2s stacked on the base's other
+/// end (x 0..2), one a step. About the base's edge (x 4) the overhang and
+/// its load turn 2.24 g * 2 + 2 * 0.80 g * 4 = 10.88 g studs, the base
+/// 1.52 g * 2 = 3.04 the other way and each counterweight 0.80 g * 3 =
+/// 2.4: it tips until the fourth (12.64).
+#[test]
+fn a_failure_is_carried_by_its_proof_until_a_counterweight_holds_it() {
+    let mut pieces = vec![
+        ("3010", 0, 0, 0, R0, 1),
+        ("3009", 3, 0, 1, R0, 2),
+        ("3004", 7, 0, 2, R0, 3),
+        ("3004", 7, 0, 3, R0, 4),
+    ];
+    for k in 0..4 {
+        pieces.push(("3004", 0, 0, 1 + k, R0, 5 + k as u32));
+    }
+    let asm = build(&pieces);
+    let params = Params::default();
+    let steps = analyze_steps(&asm, &params, false).unwrap();
+    let stands: Vec<bool> = steps.steps.iter().map(|s| s.stands).collect();
+    assert_eq!(
+        stands,
+        [true, false, false, false, false, false, false, true],
+        "{steps:?}"
+    );
+    for check in &steps.steps {
+        let whole = analyze(&asm.through_step(check.step), &params).unwrap();
+        assert_eq!(check.stands, whole.stands(), "step {}", check.step);
+    }
+    // Steps 3 to 7 fail by the proof of step 2 (the base and its overhang
+    // tip over the base's edge; each new piece moves with the one it
+    // rests on), with no program; the step the counterweight holds ends
+    // it.
+    assert_eq!(steps.failures_carried, 5, "{steps:?}");
+    // Its failing pieces are named at every step it fails.
+    for check in &steps.steps[1..7] {
+        assert!(check.min_score == 0.0 && !check.weakest.is_empty());
+    }
+}
+
 /// The finished model analysed alongside the steps (as the repairs ask
 /// for it): the same steps and `last` as a check without it, nothing
 /// solved twice, and `finished` is what `analyze` gives, even when the
@@ -576,6 +617,67 @@ fn every_step_of_a_real_build_agrees_with_a_full_solve() {
             assert!((a.usage - b.usage).abs() <= 1e-6, "{name}");
         }
     }
+}
+
+/// A mushroom: a 4 x 4 stem 10 units tall under a 20 x 20 cap 3 units
+/// thick, as an OBJ of two boxes.
+fn mushroom_obj() -> String {
+    let mut obj = String::new();
+    let boxes = [
+        [-2.0, 0.0, -2.0, 2.0, 10.0, 2.0],
+        [-10.0, 10.0, -10.0, 10.0, 13.0, 10.0],
+    ];
+    for (k, b) in boxes.iter().enumerate() {
+        for x in [b[0], b[3]] {
+            for y in [b[1], b[4]] {
+                for z in [b[2], b[5]] {
+                    obj.push_str(&format!("v {x} {y} {z}\n"));
+                }
+            }
+        }
+        let o = 8 * k + 1;
+        for q in [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ] {
+            let [a, b, c, d] = q.map(|i| i + o);
+            obj.push_str(&format!("f {a} {b} {c}\nf {a} {c} {d}\n"));
+        }
+    }
+    obj
+}
+
+/// A real build that fails part way and goes on failing: the mushroom's
+/// cap, course by course, hangs off its stem. Every step's verdict is the
+/// whole structure's program's, and the steps after the first failure
+/// are mostly carried by its proof, not solved.
+#[test]
+fn a_failing_real_build_carries_its_failure_and_agrees_with_a_full_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mushroom.obj");
+    std::fs::write(&path, mushroom_obj()).unwrap();
+    let asm = brickwright::pipeline::bricks_by_course(&path, 24).expect("the mushroom builds");
+    let params = Params::default();
+    let fast = analyze_steps(&asm, &params, false).unwrap();
+    assert!(fast.complete);
+    let first = fast.first_failure.expect("its cap hangs off the stem");
+    let after = fast
+        .steps
+        .iter()
+        .filter(|c| c.step > first && !c.stands)
+        .count();
+    assert!(after >= 2, "{fast:?}");
+    for check in &fast.steps {
+        let full = analyze(&asm.through_step(check.step), &params).unwrap();
+        assert_eq!(check.stands, full.stands(), "step {}", check.step);
+    }
+    // At 24 studs: fails from step 8 of 34, the 15 failing steps after
+    // it all carried, 2 programs solved in all.
+    assert!(4 * fast.failures_carried >= 3 * after, "{fast:?}");
 }
 
 /// The step check tells how far it is, a step at a time, as a progress

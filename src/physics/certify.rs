@@ -38,6 +38,10 @@
 //! second try), 14.4 s widened around the moved pieces (112 of 378), 13.3
 //! s with the looser gap (about 23 iterations a program, was 30).
 //!
+//! A group found with no equilibrium keeps the solver's proof of that, as
+//! a motion found again and checked ([`Certifier::still_fails`]): the
+//! steps after it that fail by the same motion need no program.
+//!
 //! A new piece whose weight pushes alone can carry down to the ground
 //! needs no program (see [`Certifier::spread_down`]): on the bunny at 48
 //! studs 27% of the new pieces the programs were asked about (419 of
@@ -118,6 +122,11 @@ pub(super) struct Certifier<'a> {
     /// A region's program past this gives no answer (see
     /// [`Certifier::until`]).
     deadline: Option<std::time::Instant>,
+    /// Per piece, its virtual motion in the last proof that its group has
+    /// no equilibrium (its lift at its centre of mass, and its tilts along
+    /// x and y: the weights of its three equations); zero for a piece no
+    /// proof moves. See [`Certifier::still_fails`].
+    proof: Vec<[f64; 3]>,
 }
 
 /// One unknown of a region's program: which force, where, and how it acts.
@@ -164,6 +173,7 @@ impl<'a> Certifier<'a> {
             found: [0; TRIES + 1],
             region_pieces: 0,
             deadline: None,
+            proof: vec![[0.0; 3]; n],
         }
     }
 
@@ -266,12 +276,9 @@ impl<'a> Certifier<'a> {
         push_vars(self.goff[p], l.ground, &l.ground_studs, p, None, out);
     }
 
-    /// Piece `p`'s equations: its weight less the forces on it (vertical,
-    /// then the moments about its centre of mass), counting contacts with
-    /// pieces before `end` only.
-    fn residual(&self, p: usize, vars: &mut Vec<Var>) -> [f64; 3] {
-        let l = &self.s.loads[p];
-        let mut r = [l.weight, 0.0, 0.0];
+    /// Every force on piece `p` (its contacts with placed pieces, its
+    /// ground) into `vars`, cleared first.
+    fn all_vars(&self, p: usize, vars: &mut Vec<Var>) {
         vars.clear();
         for &k in &self.touching[p] {
             let c = &self.s.contacts[k];
@@ -280,6 +287,15 @@ impl<'a> Certifier<'a> {
             }
         }
         self.ground_vars(p, vars);
+    }
+
+    /// Piece `p`'s equations: its weight less the forces on it (vertical,
+    /// then the moments about its centre of mass), counting contacts with
+    /// pieces before `end` only.
+    fn residual(&self, p: usize, vars: &mut Vec<Var>) -> [f64; 3] {
+        let l = &self.s.loads[p];
+        let mut r = [l.weight, 0.0, 0.0];
+        self.all_vars(p, vars);
         for v in vars.iter() {
             let f = self.f[v.at] * sign(v, p);
             r[0] -= f;
@@ -436,7 +452,7 @@ impl<'a> Certifier<'a> {
                         self.region_pieces += region.len();
                         return Verdict::Stands(stress);
                     }
-                    Tried::None(moved) => moved,
+                    Tried::None(moved, _) => moved,
                     Tried::Trouble => region.clone(),
                 };
                 widened += 1;
@@ -456,9 +472,294 @@ impl<'a> Certifier<'a> {
                 self.region_pieces += job.pieces.len();
                 Verdict::Stands(stress)
             }
-            Tried::None(_) => Verdict::Fails,
+            Tried::None(_, y) => {
+                // The group's proof, kept for the steps after (see
+                // `still_fails`).
+                self.keep_proof(job, &y);
+                Verdict::Fails
+            }
             Tried::Trouble => Verdict::Unknown,
         }
+    }
+
+    /// Keeps a proof that group `job` has no equilibrium, from the
+    /// solver's `y` (three weights a piece of the group, as
+    /// [`Found::None`]'s): that proof holds only within the solver's
+    /// tolerance, which on big groups leaves some pushes closing by as
+    /// much as the largest motion, so the motion is looked for again among
+    /// the pieces it moves ([`Certifier::motion`]) and kept only if it
+    /// holds ([`Certifier::proof_holds`]).
+    fn keep_proof(&mut self, job: &Job, y: &[f64]) {
+        for &p in &job.pieces {
+            self.proof[p] = [0.0; 3];
+        }
+        let moving = moved(&job.pieces, y);
+        let Some(motion) = self.motion(&moving) else {
+            return;
+        };
+        for (&p, m) in moving.iter().zip(motion) {
+            self.proof[p] = m;
+        }
+        let mut vars = Vec::new();
+        let bound = self.push_bound(job, &mut vars);
+        if !self.proof_holds(job, bound, &mut vars) {
+            for &p in &moving {
+                self.proof[p] = [0.0; 3];
+            }
+        }
+    }
+
+    /// A virtual motion of the pieces `moving` (sorted; every other piece
+    /// still) in which their weights do a unit of work and no push closes,
+    /// with the least the pulls at the studs can resist (Farkas' program
+    /// for a group's equilibrium, on those pieces): per piece, its lift
+    /// and tilts; none if the solver finds none.
+    fn motion(&mut self, moving: &[usize]) -> Option<Vec<[f64; 3]>> {
+        let s = self.s;
+        for (i, &p) in moving.iter().enumerate() {
+            self.local[p] = i as u32;
+        }
+        let mut vars = Vec::new();
+        for &p in moving {
+            for &k in &self.touching[p] {
+                let c = &s.contacts[k];
+                let other = if c.below == p { c.above } else { c.below };
+                // Each contact once: from its upper piece when both move.
+                let inside = self.local[other] != u32::MAX;
+                if self.on[other] && (!inside || c.above == p) {
+                    self.contact_vars(k, &mut vars);
+                }
+            }
+            self.ground_vars(p, &mut vars);
+        }
+        let ny = 3 * moving.len();
+        let tensions = vars.iter().filter(|v| v.tension).count();
+        let cols = ny + tensions;
+        // Rows: the unit of work, then per force the motion's opening
+        // (at least the pull's share, for a tension), then t >= 0.
+        let rows = 1 + vars.len() + tensions;
+        let (mut ri, mut ci, mut val) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, &p) in moving.iter().enumerate() {
+            ri.push(0);
+            ci.push(3 * i);
+            val.push(s.loads[p].weight);
+        }
+        let mut t = ny;
+        for (j, v) in vars.iter().enumerate() {
+            for p in std::iter::once(v.up).chain(v.down) {
+                let i = self.local[p];
+                if i == u32::MAX {
+                    continue;
+                }
+                let com = s.loads[p].com;
+                let f = sign(v, p);
+                for (d, x) in [1.0, v.point.0 - com.0, v.point.1 - com.1]
+                    .into_iter()
+                    .enumerate()
+                {
+                    ri.push(1 + j);
+                    ci.push(3 * i as usize + d);
+                    val.push(-f * x);
+                }
+            }
+            if v.tension {
+                ri.push(1 + j);
+                ci.push(t);
+                val.push(-1.0);
+                ri.push(1 + vars.len() + (t - ny));
+                ci.push(t);
+                val.push(-1.0);
+                t += 1;
+            }
+        }
+        for &p in moving {
+            self.local[p] = u32::MAX;
+        }
+        let a = CscMatrix::new_from_triplets(rows, cols, ri, ci, val);
+        let mut b = vec![0.0; rows];
+        b[0] = -1.0;
+        let mut cost = vec![0.0; cols];
+        cost[ny..].fill(CAP);
+        let pm = CscMatrix::zeros((cols, cols));
+        let cones = [
+            SupportedConeT::ZeroConeT(1),
+            SupportedConeT::NonnegativeConeT(rows - 1),
+        ];
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_threads(1)
+            .direct_solve_method("qdldl".to_string())
+            .build()
+            .ok()?;
+        let mut solver = DefaultSolver::new(&pm, &cost, &a, &b, &cones, settings).ok()?;
+        if let Some(deadline) = self.deadline {
+            solver.set_termination_callback(move |_| std::time::Instant::now() >= deadline);
+        }
+        solver.solve();
+        if !matches!(
+            solver.solution.status,
+            SolverStatus::Solved | SolverStatus::AlmostSolved
+        ) {
+            return None;
+        }
+        let x = &solver.solution.x;
+        Some(
+            (0..moving.len())
+                .map(|i| [x[3 * i], x[3 * i + 1], x[3 * i + 2]])
+                .collect(),
+        )
+    }
+
+    /// Whether group `job`, of which `new` (sorted) were placed since its
+    /// last verdict, still has no equilibrium by the proof kept from an
+    /// earlier step that a group of its pieces had none: a virtual motion
+    /// in which the weights do more work than the joints can resist. Each
+    /// new piece stays still or moves with a piece it touches, whichever
+    /// its joints resist less, and the motion is checked over the whole
+    /// group ([`Certifier::proof_holds`]), in time linear in its contacts.
+    /// Where it holds, the new pieces' motions are kept with the proof.
+    pub(super) fn still_fails(&mut self, job: &Job, new: &[usize]) -> bool {
+        if job.pieces.iter().all(|&p| self.proof[p] == [0.0; 3]) {
+            return false;
+        }
+        for &p in new {
+            self.proof[p] = [0.0; 3];
+        }
+        let mut vars = Vec::new();
+        let bound = self.push_bound(job, &mut vars);
+        for &p in new {
+            let mut best = (self.own_work(p, bound, &mut vars), [0.0; 3]);
+            let moving: Vec<usize> = placed_contacts(self.s, &self.touching[p], &self.on, p)
+                .map(|(_, q)| q)
+                .filter(|&q| self.proof[q] != [0.0; 3])
+                .collect();
+            for q in moving {
+                let m = self.moving_with(q, p);
+                self.proof[p] = m;
+                let w = self.own_work(p, bound, &mut vars);
+                if w < best.0 {
+                    best = (w, m);
+                }
+            }
+            self.proof[p] = best.1;
+        }
+        if self.proof_holds(job, bound, &mut vars) {
+            return true;
+        }
+        // The motion again, among the pieces it moved and the new ones (a
+        // new piece joining moving pieces to still ones may make another
+        // motion the one that fails).
+        let mut moving: Vec<usize> = job
+            .pieces
+            .iter()
+            .copied()
+            .filter(|&p| self.proof[p] != [0.0; 3])
+            .collect();
+        moving = union(&moving, new);
+        for &p in &moving {
+            self.proof[p] = [0.0; 3];
+        }
+        if let Some(motion) = self.motion(&moving) {
+            for (&p, m) in moving.iter().zip(motion) {
+                self.proof[p] = m;
+            }
+            if self.proof_holds(job, bound, &mut vars) {
+                return true;
+            }
+        }
+        for &p in &moving {
+            self.proof[p] = [0.0; 3];
+        }
+        false
+    }
+
+    /// The most any push of group `job` can carry in an equilibrium: the
+    /// group's weight and every stud's capacity. (The pieces whose bottoms
+    /// are at or above a push's height are held by the forces from the
+    /// pieces under them alone, so those pushes carry at most their weight
+    /// and the pulls at those joints.)
+    fn push_bound(&self, job: &Job, vars: &mut Vec<Var>) -> f64 {
+        let mut bound = 0.0;
+        for &p in &job.pieces {
+            bound += self.s.loads[p].weight;
+            self.below_vars(p, vars);
+            bound += CAP * vars.iter().filter(|v| v.tension).count() as f64;
+        }
+        bound
+    }
+
+    /// The forces of piece `p`'s contacts with placed pieces under it, and
+    /// of its ground: each force of a group once, from its upper piece.
+    fn below_vars(&self, p: usize, vars: &mut Vec<Var>) {
+        vars.clear();
+        for &k in &self.touching[p] {
+            let c = &self.s.contacts[k];
+            if c.above == p && self.on[c.below] {
+                self.contact_vars(k, vars);
+            }
+        }
+        self.ground_vars(p, vars);
+    }
+
+    /// Piece `q`'s kept motion, as piece `p`'s moving with it.
+    fn moving_with(&self, q: usize, p: usize) -> [f64; 3] {
+        let m = self.proof[q];
+        let (cq, cp) = (self.s.loads[q].com, self.s.loads[p].com);
+        [
+            m[0] + m[1] * (cp.0 - cq.0) + m[2] * (cp.1 - cq.1),
+            m[1],
+            m[2],
+        ]
+    }
+
+    /// How far force `v` opens its joint in the kept motion: the work a
+    /// unit of it does (a push's pieces part, a pull's are pressed
+    /// together, where it is positive).
+    fn opening(&self, v: &Var) -> f64 {
+        std::iter::once(v.up)
+            .chain(v.down)
+            .map(|p| {
+                let (m, com) = (self.proof[p], self.s.loads[p].com);
+                sign(v, p) * (m[0] + m[1] * (v.point.0 - com.0) + m[2] * (v.point.1 - com.1))
+            })
+            .sum()
+    }
+
+    /// The most work force `v` can do against the kept motion: a pull at a
+    /// stud's capacity, a push at `bound`.
+    fn resisted(&self, v: &Var, bound: f64) -> f64 {
+        let a = self.opening(v);
+        if a >= 0.0 {
+            0.0
+        } else if v.tension {
+            -a * CAP
+        } else {
+            -a * bound
+        }
+    }
+
+    /// Piece `p`'s part of the kept motion's balance: its weight's work
+    /// (negative where it falls) and what its joints resist.
+    fn own_work(&self, p: usize, bound: f64, vars: &mut Vec<Var>) -> f64 {
+        self.all_vars(p, vars);
+        let l = &self.s.loads[p];
+        l.weight * self.proof[p][0] + vars.iter().map(|v| self.resisted(v, bound)).sum::<f64>()
+    }
+
+    /// Whether the kept motion proves that group `job` has no equilibrium
+    /// (Farkas): the work its weights do in it (lifts times weights) is
+    /// more than every joint together can resist, a pull at most a stud's
+    /// capacity and a push at most `bound`, by more than rounding.
+    fn proof_holds(&self, job: &Job, bound: f64, vars: &mut Vec<Var>) -> bool {
+        let (mut work, mut scale) = (0.0, 0.0);
+        for &p in &job.pieces {
+            let w = self.s.loads[p].weight * self.proof[p][0];
+            work += w;
+            scale += w.abs();
+            self.below_vars(p, vars);
+            work += vars.iter().map(|v| self.resisted(v, bound)).sum::<f64>();
+        }
+        scale > 0.0 && work < -1e-9 * scale
     }
 
     /// The first region for the new pieces `new`: they, ways down to the
@@ -654,7 +955,7 @@ impl<'a> Certifier<'a> {
         }
         let (vars, change) = match found {
             Found::Change(vars, change) => (vars, change),
-            Found::None(moved) => return Tried::None(moved),
+            Found::None(y) => return Tried::None(moved(region, &y), y),
             Found::Trouble => return Tried::Trouble,
         };
         let before: Vec<f64> = vars.iter().map(|v| self.f[v.at]).collect();
@@ -682,14 +983,7 @@ impl<'a> Certifier<'a> {
         job.pieces
             .iter()
             .map(|&p| {
-                vars.clear();
-                for &k in &self.touching[p] {
-                    let c = &self.s.contacts[k];
-                    if self.on[c.below] && self.on[c.above] {
-                        self.contact_vars(k, &mut vars);
-                    }
-                }
-                self.ground_vars(p, &mut vars);
+                self.all_vars(p, &mut vars);
                 let usage = vars
                     .iter()
                     .filter(|v| v.tension)
@@ -798,7 +1092,7 @@ impl<'a> Certifier<'a> {
                 Found::Change(vars, solver.solution.x.clone())
             }
             SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                Found::None(moved(region, &solver.solution.z[..eq]))
+                Found::None(solver.solution.z[..eq].to_vec())
             }
             _ => Found::Trouble,
         }
@@ -864,8 +1158,9 @@ fn pushes_holding(
 enum Found {
     /// A change to these forces.
     Change(Vec<Var>, Vec<f64>),
-    /// None exists: the pieces of the region its proof moves.
-    None(Vec<usize>),
+    /// None exists: the solver's proof of that, three weights a piece of
+    /// the region (see [`moved`]).
+    None(Vec<f64>),
     /// The solver gave no answer.
     Trouble,
 }
@@ -874,8 +1169,9 @@ enum Found {
 enum Tried {
     /// It was found and balances every piece: each piece's stress.
     Stands(Vec<PieceStress>),
-    /// None exists in the region: the pieces its proof moves.
-    None(Vec<usize>),
+    /// None exists in the region: the pieces its proof moves, and the
+    /// proof (as [`Found::None`]'s).
+    None(Vec<usize>, Vec<f64>),
     /// The solver gave no answer, or the change found did not check.
     Trouble,
 }

@@ -674,7 +674,7 @@ fn check_steps_in(
             _ => bounds.push((p.step.0, i + 1)),
         }
     }
-    let (mut reused, mut solves, mut certified) = (0, 0, 0);
+    let (mut reused, mut solves, mut certified, mut carried) = (0, 0, 0, 0);
     let mut current = vec![PieceStress::falling(); n];
     // Whether each piece's entry in `current` is exact: found for the
     // group it is in now (see `solve_all_but`).
@@ -778,6 +778,17 @@ fn check_steps_in(
                 reused += 1;
             } else if !job.grounded || k == last_k && fin.given {
                 late.push(job);
+            } else if !stood && cert.still_fails(job, &fresh) {
+                // Still failing by the proof kept from a step before: its
+                // pieces that failed then are named again, the new ones
+                // not (the finished model's program is exact).
+                for &p in &fresh {
+                    current[p] = PieceStress::resting();
+                }
+                for &p in &job.pieces {
+                    exact[p] = false;
+                }
+                carried += 1;
             } else if take_certificate(&mut cert, job, begin, &mut current, &mut exact) {
                 certified += 1;
             } else {
@@ -898,6 +909,7 @@ fn check_steps_in(
         reused,
         certified,
         whole_certified: cert.found[cert.found.len() - 1],
+        failures_carried: carried,
         complete,
         finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
         map: drawn,

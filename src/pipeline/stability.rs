@@ -178,6 +178,9 @@ pub struct StabilityReport {
     /// Of those, the groups whose change took the program of the whole
     /// group (no region near the new pieces had one).
     pub whole_certified: usize,
+    /// Groups found still failing after a failed step by the proof made
+    /// there, without a program (see docs/stability.md).
+    pub failures_carried: usize,
     /// Where the finished model's usages (`min_score`, `max_usage`,
     /// `weakest`, the stress picture) come from: `program`, the force
     /// program with one answer; `certificates`, the equilibria that
@@ -508,6 +511,7 @@ struct Counts {
     reused: usize,
     certified: usize,
     whole_certified: usize,
+    failures_carried: usize,
 }
 
 impl Counts {
@@ -516,6 +520,7 @@ impl Counts {
         self.reused += c.reused;
         self.certified += c.certified;
         self.whole_certified += c.whole_certified;
+        self.failures_carried += c.failures_carried;
     }
 }
 
@@ -1199,6 +1204,7 @@ fn report(
         reused: counts.reused,
         certified: counts.certified,
         whole_certified: counts.whole_certified,
+        failures_carried: counts.failures_carried,
         stress_map,
     }
 }
