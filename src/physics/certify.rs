@@ -83,6 +83,13 @@ const FOOTING_DIRECTIONS: [(f64, f64); 8] = [
 /// change found pushes rather than pulls, keeping clutch for later steps.
 const PUSH_COST: f64 = 1e-3;
 
+/// The share of its weights' work by which a kept proof must exceed what
+/// the joints can resist: one that holds by less goes to the programs,
+/// whose verdict lets a hand hold up to [`Params::fall_tolerance`] of a
+/// piece's weight (the proofs kept on the cow at 64 studs hold by a third
+/// of it or more).
+const PROOF_MARGIN: f64 = 1e-3;
+
 /// What the certificate says of a group after a step.
 pub(super) enum Verdict {
     /// It stands: each piece's stress in the equilibrium found, in the
@@ -749,7 +756,7 @@ impl<'a> Certifier<'a> {
     /// Whether the kept motion proves that group `job` has no equilibrium
     /// (Farkas): the work its weights do in it (lifts times weights) is
     /// more than every joint together can resist, a pull at most a stud's
-    /// capacity and a push at most `bound`, by more than rounding.
+    /// capacity and a push at most `bound`, by [`PROOF_MARGIN`] of it.
     fn proof_holds(&self, job: &Job, bound: f64, vars: &mut Vec<Var>) -> bool {
         let (mut work, mut scale) = (0.0, 0.0);
         for &p in &job.pieces {
@@ -759,7 +766,7 @@ impl<'a> Certifier<'a> {
             self.below_vars(p, vars);
             work += vars.iter().map(|v| self.resisted(v, bound)).sum::<f64>();
         }
-        scale > 0.0 && work < -1e-9 * scale
+        scale > 0.0 && work < -PROOF_MARGIN * scale
     }
 
     /// The first region for the new pieces `new`: they, ways down to the
