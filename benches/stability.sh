@@ -6,6 +6,7 @@
 # the budget, whether the build stands at every step, force programs
 # solved, groups certified by a change to the kept equilibrium and, of
 # those, the ones whose change took the whole group's program, the
+# failing groups carried by a proof kept from an earlier step, the
 # stage's seconds and the whole run's. Organic meshes are the
 # slow case: most of their steps add pieces that need clutch, and each
 # such step is a program of the pieces around its new ones.
@@ -20,8 +21,8 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 budget=()
 if [ -n "${BUDGET:-}" ]; then budget=(--stability-budget "$BUDGET"); fi
-printf '| mesh | studs | pieces | steps | checked | complete | stands | programs | certified | whole | stage s | run s |\n'
-printf '|---|---|---|---|---|---|---|---|---|---|---|---|\n'
+printf '| mesh | studs | pieces | steps | checked | complete | stands | programs | certified | whole | carried | stage s | run s |\n'
+printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|\n'
 for mesh in "$@"; do
   for n in $sizes; do
     name=$(basename "$mesh")
@@ -33,7 +34,7 @@ r = json.load(open(sys.argv[1])); secs = open(sys.argv[2]).read().split()[-1]
 s = r["stability"]
 print(f"| {sys.argv[3]} | {sys.argv[4]} | {r['pieces']} | {r['steps']} | {s['steps_checked']} "
       f"| {'yes' if s['complete'] else 'no'} | {'yes' if s['stands'] else 'no'} | {s['solves']} "
-      f"| {s['certified']} | {s['whole_certified']} "
+      f"| {s['certified']} | {s['whole_certified']} | {s['failures_carried']} "
       f"| {r['seconds']['stability']:.1f} | {secs} |")
 PY
     else
