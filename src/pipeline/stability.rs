@@ -621,7 +621,7 @@ impl Attempt {
             let pending = self
                 .pending
                 .get_or_insert_with(|| Pending::start(&self.plan.1, params));
-            if let Some(made) = pending.wait_until(Some(until)) {
+            if let Some(made) = made_in_time(pending, until) {
                 counts.solves += 1;
                 self.finished = Some(made?);
                 self.pending = None;
@@ -911,14 +911,8 @@ fn map_finished(
                 .unwrap_or_else(|| Pending::start(assembly, params));
             // Not made by the deadline, or seen not to end by then (at
             // the pace of its iterations so far): dropped, it stops.
-            let made = loop {
-                let soon = deadline.min(Instant::now() + LOOK);
-                if let Some(made) = job.wait_until(Some(soon)) {
-                    break made;
-                }
-                if Instant::now() >= deadline || !job.may_end_by(deadline) {
-                    return Ok(StressMap::Certificates);
-                }
+            let Some(made) = made_in_time(&job, deadline) else {
+                return Ok(StressMap::Certificates);
             };
             counts.solves += 1;
             finished.insert(made?)
@@ -930,6 +924,25 @@ fn map_finished(
         );
     }
     Ok(StressMap::Program)
+}
+
+/// The analysis `job` once made by `deadline`; `None` if it is not, or as
+/// soon as it is seen not to end by then at the pace of its iterations so
+/// far ([`Pending::may_end_by`]): the bunny at 96 studs (11,696 pieces)
+/// waited out the whole budget for a program of several times that.
+fn made_in_time(
+    job: &Pending,
+    deadline: Instant,
+) -> Option<Result<Analysis, crate::physics::PhysicsError>> {
+    loop {
+        let soon = deadline.min(Instant::now() + LOOK);
+        if let Some(made) = job.wait_until(Some(soon)) {
+            return Some(made);
+        }
+        if Instant::now() >= deadline || !job.may_end_by(deadline) {
+            return None;
+        }
+    }
 }
 
 /// Pieces past which the finished model's map is drawn from the
