@@ -360,14 +360,7 @@ impl<'a> Certifier<'a> {
                 continue;
             };
             through.push(q);
-            vars.clear();
-            for &k in &self.touching[q] {
-                let c = &s.contacts[k];
-                if c.above == q && self.on[c.below] {
-                    self.contact_vars(k, &mut vars);
-                }
-            }
-            self.ground_vars(q, &mut vars);
+            self.below_vars(q, &mut vars);
             let Some(shares) = (w > 0.0)
                 .then(|| pushes_holding((mx / w, my / w), w, &vars, straight))
                 .flatten()
@@ -476,10 +469,10 @@ impl<'a> Certifier<'a> {
                 self.region_pieces += job.pieces.len();
                 Verdict::Stands(stress)
             }
-            Tried::None(_, y) => {
+            Tried::None(moving, y) => {
                 // The group's proof, kept for the steps after (see
                 // `still_fails`).
-                self.keep_proof(job, &y);
+                self.keep_proof(job, &moving, &y);
                 Verdict::Fails
             }
             Tried::Trouble => Verdict::Unknown,
@@ -488,14 +481,14 @@ impl<'a> Certifier<'a> {
 
     /// Keeps a proof that group `job` has no equilibrium, from the
     /// solver's `y` (three weights a piece of the group, as
-    /// [`Found::None`]'s), as it is: that proof holds only within the
+    /// [`Found::None`]'s) on the pieces it moves (`moving`, sorted), as it
+    /// is: that proof holds only within the
     /// solver's tolerance, which on big groups leaves some pushes closing
     /// by as much as the largest motion, so [`Certifier::still_fails`]
     /// looks for the motion again among the pieces it moves and the new
     /// ones ([`Certifier::motion`]) when it first needs it (a check that
     /// stops at its first failure never does).
-    fn keep_proof(&mut self, job: &Job, y: &[f64]) {
-        let moving = moved(&job.pieces, y);
+    fn keep_proof(&mut self, job: &Job, moving: &[usize], y: &[f64]) {
         for (i, &p) in job.pieces.iter().enumerate() {
             let kept = moving.binary_search(&p).is_ok();
             self.raw[p] = kept;
@@ -664,24 +657,13 @@ impl<'a> Certifier<'a> {
         for &p in &raw {
             self.raw[p] = false;
         }
-        for &p in new.iter().filter(|_| raw.is_empty()) {
-            let mut best = (self.own_work(p, bound, &mut vars), [0.0; 3]);
-            let moving: Vec<usize> = placed_contacts(self.s, &self.touching[p], &self.on, p)
-                .map(|(_, q)| q)
-                .filter(|&q| self.proof[q] != [0.0; 3])
-                .collect();
-            for q in moving {
-                let m = self.moving_with(q, p);
-                self.proof[p] = m;
-                let w = self.own_work(p, bound, &mut vars);
-                if w < best.0 {
-                    best = (w, m);
-                }
+        if raw.is_empty() {
+            for &p in new {
+                self.follow(p, bound, &mut vars);
             }
-            self.proof[p] = best.1;
-        }
-        if raw.is_empty() && self.proof_holds(job, bound, &mut vars) {
-            return true;
+            if self.proof_holds(job, bound, &mut vars) {
+                return true;
+            }
         }
         // The motion again, among the pieces it moved and the new ones (a
         // new piece joining moving pieces to still ones may make another
@@ -708,6 +690,25 @@ impl<'a> Certifier<'a> {
             self.proof[p] = [0.0; 3];
         }
         false
+    }
+
+    /// Gives new piece `p` the motion its joints resist least: still, or
+    /// moving with a piece it touches that moves.
+    fn follow(&mut self, p: usize, bound: f64, vars: &mut Vec<Var>) {
+        let mut best = (self.own_work(p, bound, vars), [0.0; 3]);
+        let moving: Vec<usize> = placed_contacts(self.s, &self.touching[p], &self.on, p)
+            .map(|(_, q)| q)
+            .filter(|&q| self.proof[q] != [0.0; 3])
+            .collect();
+        for q in moving {
+            let m = self.moving_with(q, p);
+            self.proof[p] = m;
+            let w = self.own_work(p, bound, vars);
+            if w < best.0 {
+                best = (w, m);
+            }
+        }
+        self.proof[p] = best.1;
     }
 
     /// The most any push of group `job` can carry in an equilibrium with
@@ -739,15 +740,16 @@ impl<'a> Certifier<'a> {
         self.ground_vars(p, vars);
     }
 
+    /// How far point `at` of piece `p` rises in the kept motion.
+    fn lift(&self, p: usize, at: (f64, f64)) -> f64 {
+        let (m, com) = (self.proof[p], self.s.loads[p].com);
+        m[0] + m[1] * (at.0 - com.0) + m[2] * (at.1 - com.1)
+    }
+
     /// Piece `q`'s kept motion, as piece `p`'s moving with it.
     fn moving_with(&self, q: usize, p: usize) -> [f64; 3] {
         let m = self.proof[q];
-        let (cq, cp) = (self.s.loads[q].com, self.s.loads[p].com);
-        [
-            m[0] + m[1] * (cp.0 - cq.0) + m[2] * (cp.1 - cq.1),
-            m[1],
-            m[2],
-        ]
+        [self.lift(q, self.s.loads[p].com), m[1], m[2]]
     }
 
     /// How far force `v` opens its joint in the kept motion: the work a
@@ -756,10 +758,7 @@ impl<'a> Certifier<'a> {
     fn opening(&self, v: &Var) -> f64 {
         std::iter::once(v.up)
             .chain(v.down)
-            .map(|p| {
-                let (m, com) = (self.proof[p], self.s.loads[p].com);
-                sign(v, p) * (m[0] + m[1] * (v.point.0 - com.0) + m[2] * (v.point.1 - com.1))
-            })
+            .map(|p| sign(v, p) * self.lift(p, v.point))
             .sum()
     }
 
@@ -812,12 +811,12 @@ impl<'a> Certifier<'a> {
     /// `p`'s kept motion: [`Params::fall_tolerance`] of its weight, pushing
     /// up at the corner of its footprint that sinks most.
     fn hand(&self, p: usize) -> f64 {
-        let (l, m) = (&self.s.loads[p], self.proof[p]);
+        let l = &self.s.loads[p];
         let sinks = l
             .extent
             .corners()
             .iter()
-            .map(|c| -(m[0] + m[1] * (c.0 - l.com.0) + m[2] * (c.1 - l.com.1)))
+            .map(|&c| -self.lift(p, c))
             .fold(0.0, f64::max);
         self.tol * l.weight * sinks
     }
