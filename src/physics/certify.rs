@@ -43,13 +43,15 @@
 //! answer rather than a proof that none exists ([`EARLY_RESIDUAL`]), it
 //! is settled ([`Certifier::settle`]: clamped to its bounds, then moved
 //! by the least change that closes every piece's equations) and checked
-//! like any answer; one that does not check is solved again to the end.
-//! A program's second half of its iterations went in closing residuals
-//! far below the check's tolerance: on the bunny at 72 studs (5,025
-//! pieces) the stage went from 35 s to 17 s: of its 451 programs, 282
-//! stopped early and 25 of those were solved again (9 of them had no
-//! answer: an iterate can look near one before the solver sees there is
-//! none).
+//! like any answer; one that does not check is solved again, stopped at
+//! a hundredth of that residual, then to the end. A program's second
+//! half of its iterations went in closing residuals far below the
+//! check's tolerance: on the bunny at 72 studs (5,025 pieces) the stage
+//! went from 35 s to 17 s. Of its 453 programs 172 found no change (their
+//! proofs widen the region) and 281 stopped early; 15 of those did not
+//! settle, and tried again 7 settled and 8 had no answer (an iterate can
+//! look near one before the solver sees there is none); none ran to its
+//! end.
 //!
 //! A group found with no equilibrium keeps the solver's proof of that, as
 //! a motion found again and checked ([`Certifier::still_fails`]): the
@@ -106,8 +108,9 @@ const PUSH_COST: f64 = 1e-3;
 const EARLY_RESIDUAL: f64 = 1e-2;
 
 /// Rounds of [`Certifier::settle`]: each fixes the forces its step would
-/// take past a bound at that bound, and solves again for the rest.
-const SETTLE_ROUNDS: usize = 4;
+/// take past a bound at that bound, or frees a fixed one the step would
+/// move back inside, and solves again.
+const SETTLE_ROUNDS: usize = 8;
 
 /// The least distance to a bound by which [`Certifier::settle`] weighs a
 /// force's change, so that forces at a bound still move when only they
@@ -1039,10 +1042,11 @@ impl<'a> Certifier<'a> {
         for (i, &p) in region.iter().enumerate() {
             self.local[p] = i as u32;
         }
-        let mut found = self.solve_region(region, true);
+        let mut early = EARLY_RESIDUAL;
+        let mut found = self.solve_region(region, early);
         let tried = loop {
-            let (vars, change, early) = match found {
-                Found::Change(vars, change, early) => (vars, change, early),
+            let (vars, change) = match found {
+                Found::Change(vars, change) => (vars, change),
                 Found::None(y) => break Tried::None(moved(region, &y), y),
                 Found::Trouble => break Tried::Trouble,
             };
@@ -1061,11 +1065,17 @@ impl<'a> Certifier<'a> {
             for (v, f) in vars.iter().zip(before) {
                 self.f[v.at] = f;
             }
-            if !early {
+            if early == 0.0 {
                 break Tried::Trouble;
             }
-            // The early iterate did not settle: the program to its end.
-            found = self.solve_region(region, false);
+            // The early iterate did not settle: once more, nearer (a
+            // hundredth of the residual), then to the program's end.
+            early = if early == EARLY_RESIDUAL {
+                EARLY_RESIDUAL * EARLY_RESIDUAL
+            } else {
+                0.0
+            };
+            found = self.solve_region(region, early);
         };
         for &p in region {
             self.local[p] = u32::MAX;
@@ -1105,9 +1115,11 @@ impl<'a> Certifier<'a> {
     /// inverse square of each force's distance to its nearest bound (at
     /// least [`SETTLE_FLOOR`]), that closes the equations' residual; a
     /// force that step would take past a bound is fixed there and the
-    /// rest solved again, for at most [`SETTLE_ROUNDS`] rounds. Whether
-    /// the answer balances is for the caller's check to say. None where
-    /// the system cannot be factored.
+    /// rest solved again; where a residual is left that only a fixed
+    /// force could close (the step's multipliers would move it back
+    /// inside its bounds), that force goes free again; for at most
+    /// [`SETTLE_ROUNDS`] rounds. Whether the answer balances is for the
+    /// caller's check to say. None where the system cannot be factored.
     fn settle(&self, vars: &[Var], d: &[f64], rhs: &[f64], a: &CscMatrix<f64>) -> Option<Vec<f64>> {
         let (nv, neq) = (vars.len(), rhs.len());
         let bounds: Vec<(f64, f64)> = vars
@@ -1135,6 +1147,9 @@ impl<'a> Certifier<'a> {
                 for (i, v) in rows(j) {
                     residual[i] -= v * x;
                 }
+            }
+            if residual.iter().all(|r| r.abs() < 1e-12) {
+                break;
             }
             // The least weighted change over the free forces: the
             // quasi-definite system [W A'; A -eps I] [dx; -l] = [0; r].
@@ -1192,7 +1207,28 @@ impl<'a> Certifier<'a> {
                 }
             }
             if !past {
-                break;
+                // Closed, unless a piece's residual needs a force fixed at
+                // a bound: one the step's multipliers would move back
+                // inside goes free again.
+                let mut freed = false;
+                for j in 0..nv {
+                    if !fixed[j] {
+                        continue;
+                    }
+                    let pull: f64 = rows(j).map(|(i, v)| v * step[free + i]).sum();
+                    let inward = if y[j] == bounds[j].0 {
+                        pull < 0.0
+                    } else {
+                        pull > 0.0
+                    };
+                    if inward {
+                        fixed[j] = false;
+                        freed = true;
+                    }
+                }
+                if !freed {
+                    break;
+                }
             }
         }
         Some(y)
@@ -1267,9 +1303,10 @@ impl<'a> Certifier<'a> {
     }
 
     /// The region's [`Certifier::program`] solved (its pieces numbered in
-    /// `self.local`). With `early`, the solver stops at an iterate near
-    /// enough (see [`EARLY_RESIDUAL`]), settled.
-    fn solve_region(&self, region: &[usize], early: bool) -> Found {
+    /// `self.local`). With `early` above 0, the solver stops at an
+    /// iterate whose residual and kappa/tau ratio are under it (see
+    /// [`EARLY_RESIDUAL`]), settled.
+    fn solve_region(&self, region: &[usize], early: f64) -> Found {
         let Program {
             vars,
             a,
@@ -1303,7 +1340,7 @@ impl<'a> Certifier<'a> {
             return Found::Trouble;
         }
         let near = move |i: &clarabel::solver::DefaultInfo<f64>| {
-            early && i.iterations > 0 && i.res_primal < EARLY_RESIDUAL && i.ktratio < EARLY_RESIDUAL
+            i.iterations > 0 && i.res_primal < early && i.ktratio < early
         };
         solver.set_termination_callback(move |i| {
             near(i) || deadline.is_some_and(|d| std::time::Instant::now() >= d)
@@ -1311,14 +1348,14 @@ impl<'a> Certifier<'a> {
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Found::Change(vars, solver.solution.x.clone(), false)
+                Found::Change(vars, solver.solution.x.clone())
             }
             SolverStatus::CallbackTerminated if near(&solver.info) => {
                 let x = &solver.solution.x;
                 let d = self
                     .settle(&vars, x, &b[..eq], &a)
                     .unwrap_or_else(|| x.clone());
-                Found::Change(vars, d, true)
+                Found::Change(vars, d)
             }
             SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
                 Found::None(solver.solution.z[..eq].to_vec())
@@ -1385,9 +1422,8 @@ fn pushes_holding(
 
 /// What a region's program found.
 enum Found {
-    /// A change to these forces; whether it is an early iterate settled
-    /// (see [`EARLY_RESIDUAL`]).
-    Change(Vec<Var>, Vec<f64>, bool),
+    /// A change to these forces.
+    Change(Vec<Var>, Vec<f64>),
     /// None exists: the solver's proof of that, three weights a piece of
     /// the region (see [`moved`]).
     None(Vec<f64>),
@@ -1684,7 +1720,7 @@ mod tests {
         for (i, &p) in job.pieces.iter().enumerate() {
             cert.local[p] = i as u32;
         }
-        let Found::Change(vars, exact, false) = cert.solve_region(&job.pieces, false) else {
+        let Found::Change(vars, exact) = cert.solve_region(&job.pieces, 0.0) else {
             panic!("the counterweighted build has an equilibrium");
         };
         let program = cert.program(&job.pieces);
