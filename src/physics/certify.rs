@@ -38,20 +38,21 @@
 //! second try), 14.4 s widened around the moved pieces (112 of 378), 13.3
 //! s with the looser gap (about 23 iterations a program, was 30).
 //!
-//! They stop earlier still: once an iterate balances the region within
-//! a hundredth (the solver's relative residual) and is headed for an
-//! answer rather than a proof that none exists ([`EARLY_RESIDUAL`]), it
+//! They stop earlier still: once the solver's relative primal residual
+//! (against the norms of the data and of the iterate) is under a
+//! hundredth and the iterate is headed for an answer rather than a
+//! proof that none exists ([`EARLY_RESIDUAL`]), it
 //! is settled ([`Certifier::settle`]: clamped to its bounds, then moved
 //! by the least change that closes every piece's equations) and checked
 //! like any answer; one that does not check is solved again, stopped at
 //! a hundredth of that residual, then to the end. A program's second
 //! half of its iterations went in closing residuals far below the
 //! check's tolerance: on the bunny at 72 studs (5,025 pieces) the stage
-//! went from 35 s to 17 s. Of its 453 programs 172 found no change (their
-//! proofs widen the region) and 281 stopped early; 15 of those did not
-//! settle, and tried again 7 settled and 8 had no answer (an iterate can
-//! look near one before the solver sees there is none); none ran to its
-//! end.
+//! went from 34.7 s to 18.5 s (idle cores). Of its 453 programs 172
+//! found no change (their proofs widen the region) and 281 stopped
+//! early; 15 of those did not settle, and tried again 7 settled and 8
+//! had no answer (an iterate can look near one before the solver sees
+//! there is none); none ran to its end.
 //!
 //! A group found with no equilibrium keeps the solver's proof of that, as
 //! a motion found again and checked ([`Certifier::still_fails`]): the
@@ -98,8 +99,9 @@ const FOOTING_DIRECTIONS: [(f64, f64); 8] = [
 /// change found pushes rather than pulls, keeping clutch for later steps.
 const PUSH_COST: f64 = 1e-3;
 
-/// A region's program is stopped early, once its iterate balances the
-/// region within this share (the solver's relative primal residual) and
+/// A region's program is stopped early, once the solver's relative
+/// primal residual (against the norms of the data and of the iterate) is
+/// under this and
 /// its homogeneous embedding's kappa/tau ratio is as small (an iterate
 /// headed for an answer, not for a proof that there is none); the
 /// iterate is then settled (see [`Certifier::settle`]) and checked like
@@ -111,6 +113,11 @@ const EARLY_RESIDUAL: f64 = 1e-2;
 /// take past a bound at that bound, or frees a fixed one the step would
 /// move back inside, and solves again.
 const SETTLE_ROUNDS: usize = 8;
+
+/// A piece's equation is closed by [`Certifier::settle`] within this
+/// (forces in clutch capacities: a millionth of the check's tolerance for
+/// the lightest part, a plate 1 x 1).
+const CLOSED: f64 = 1e-12;
 
 /// The least distance to a bound by which [`Certifier::settle`] weighs a
 /// force's change, so that forces at a bound still move when only they
@@ -1045,8 +1052,8 @@ impl<'a> Certifier<'a> {
         let mut early = EARLY_RESIDUAL;
         let mut found = self.solve_region(region, early);
         let tried = loop {
-            let (vars, change) = match found {
-                Found::Change(vars, change) => (vars, change),
+            let (vars, change, settled) = match found {
+                Found::Change(vars, change, settled) => (vars, change, settled),
                 Found::None(y) => break Tried::None(moved(region, &y), y),
                 Found::Trouble => break Tried::Trouble,
             };
@@ -1065,7 +1072,7 @@ impl<'a> Certifier<'a> {
             for (v, f) in vars.iter().zip(before) {
                 self.f[v.at] = f;
             }
-            if early == 0.0 {
+            if !settled || early == 0.0 {
                 break Tried::Trouble;
             }
             // The early iterate did not settle: once more, nearer (a
@@ -1119,8 +1126,9 @@ impl<'a> Certifier<'a> {
     /// force could close (the step's multipliers would move it back
     /// inside its bounds), that force goes free again; for at most
     /// [`SETTLE_ROUNDS`] rounds. Whether the answer balances is for the
-    /// caller's check to say. None where the system cannot be factored.
-    fn settle(&self, vars: &[Var], d: &[f64], rhs: &[f64], a: &CscMatrix<f64>) -> Option<Vec<f64>> {
+    /// caller's check to say (a round whose system cannot be factored
+    /// ends the rounds).
+    fn settle(&self, vars: &[Var], d: &[f64], rhs: &[f64], a: &CscMatrix<f64>) -> Vec<f64> {
         let (nv, neq) = (vars.len(), rhs.len());
         let bounds: Vec<(f64, f64)> = vars
             .iter()
@@ -1141,6 +1149,9 @@ impl<'a> Certifier<'a> {
                 .map(|k| (a.rowval[k], a.nzval[k]))
         };
         let mut fixed = vec![false; nv];
+        // The multipliers of the last round, where it took no force past a
+        // bound.
+        let mut multipliers: Option<Vec<f64>> = None;
         for _ in 0..SETTLE_ROUNDS {
             let mut residual = rhs.to_vec();
             for (j, &x) in y.iter().enumerate() {
@@ -1148,8 +1159,32 @@ impl<'a> Certifier<'a> {
                     residual[i] -= v * x;
                 }
             }
-            if residual.iter().all(|r| r.abs() < 1e-12) {
+            if residual.iter().all(|r| r.abs() < CLOSED) {
                 break;
+            }
+            if let Some(m) = multipliers.take() {
+                // A residual left that only a force fixed at a bound can
+                // close: one the multipliers would move back inside its
+                // bounds goes free again (none: nothing more to do).
+                let mut freed = false;
+                for j in 0..nv {
+                    if !fixed[j] {
+                        continue;
+                    }
+                    let pull: f64 = rows(j).map(|(i, v)| v * m[i]).sum();
+                    let inward = if y[j] == bounds[j].0 {
+                        pull < 0.0
+                    } else {
+                        pull > 0.0
+                    };
+                    if inward {
+                        fixed[j] = false;
+                        freed = true;
+                    }
+                }
+                if !freed {
+                    break;
+                }
             }
             // The least weighted change over the free forces: the
             // quasi-definite system [W A'; A -eps I] [dx; -l] = [0; r].
@@ -1180,14 +1215,16 @@ impl<'a> Certifier<'a> {
             }
             let m = free + neq;
             let kkt = CscMatrix::new(m, m, colptr, rowval, nzval);
-            let mut signs = vec![1_i8; free];
-            signs.resize(m, -1);
-            let settings = clarabel::qdldl::QDLDLSettingsBuilder::default()
-                .Dsigns(signs)
+            // No regularisation: the system is quasi-definite as it is.
+            let Ok(settings) = clarabel::qdldl::QDLDLSettingsBuilder::default()
                 .regularize_enable(false)
                 .build()
-                .ok()?;
-            let mut ldl = clarabel::qdldl::QDLDLFactorisation::new(&kkt, Some(settings)).ok()?;
+            else {
+                break;
+            };
+            let Ok(mut ldl) = clarabel::qdldl::QDLDLFactorisation::new(&kkt, Some(settings)) else {
+                break;
+            };
             let mut step = vec![0.0; m];
             step[free..].copy_from_slice(&residual);
             ldl.solve(&mut step);
@@ -1196,7 +1233,7 @@ impl<'a> Certifier<'a> {
                 let (lo, hi) = bounds[j];
                 let x = y[j] + step[at[j]];
                 if !x.is_finite() {
-                    return None;
+                    return y;
                 }
                 if x < lo || x > hi {
                     y[j] = x.clamp(lo, hi);
@@ -1207,31 +1244,10 @@ impl<'a> Certifier<'a> {
                 }
             }
             if !past {
-                // Closed, unless a piece's residual needs a force fixed at
-                // a bound: one the step's multipliers would move back
-                // inside goes free again.
-                let mut freed = false;
-                for j in 0..nv {
-                    if !fixed[j] {
-                        continue;
-                    }
-                    let pull: f64 = rows(j).map(|(i, v)| v * step[free + i]).sum();
-                    let inward = if y[j] == bounds[j].0 {
-                        pull < 0.0
-                    } else {
-                        pull > 0.0
-                    };
-                    if inward {
-                        fixed[j] = false;
-                        freed = true;
-                    }
-                }
-                if !freed {
-                    break;
-                }
+                multipliers = Some(step[free..].to_vec());
             }
         }
-        Some(y)
+        y
     }
 
     /// The program of a region (its pieces numbered in `self.local`): the
@@ -1348,14 +1364,11 @@ impl<'a> Certifier<'a> {
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Found::Change(vars, solver.solution.x.clone())
+                Found::Change(vars, solver.solution.x.clone(), false)
             }
             SolverStatus::CallbackTerminated if near(&solver.info) => {
-                let x = &solver.solution.x;
-                let d = self
-                    .settle(&vars, x, &b[..eq], &a)
-                    .unwrap_or_else(|| x.clone());
-                Found::Change(vars, d)
+                let d = self.settle(&vars, &solver.solution.x, &b[..eq], &a);
+                Found::Change(vars, d, true)
             }
             SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
                 Found::None(solver.solution.z[..eq].to_vec())
@@ -1422,8 +1435,9 @@ fn pushes_holding(
 
 /// What a region's program found.
 enum Found {
-    /// A change to these forces.
-    Change(Vec<Var>, Vec<f64>),
+    /// A change to these forces; whether it is an early iterate settled
+    /// (see [`EARLY_RESIDUAL`]).
+    Change(Vec<Var>, Vec<f64>, bool),
     /// None exists: the solver's proof of that, three weights a piece of
     /// the region (see [`moved`]).
     None(Vec<f64>),
@@ -1720,7 +1734,7 @@ mod tests {
         for (i, &p) in job.pieces.iter().enumerate() {
             cert.local[p] = i as u32;
         }
-        let Found::Change(vars, exact) = cert.solve_region(&job.pieces, 0.0) else {
+        let Found::Change(vars, exact, false) = cert.solve_region(&job.pieces, 0.0) else {
             panic!("the counterweighted build has an equilibrium");
         };
         let program = cert.program(&job.pieces);
@@ -1730,9 +1744,7 @@ mod tests {
             .map(|(j, x)| x + 1e-3 * ((j as f64) * 1.7).sin())
             .collect();
         let eq = program.eq;
-        let settled = cert
-            .settle(&program.vars, &off, &program.b[..eq], &program.a)
-            .unwrap();
+        let settled = cert.settle(&program.vars, &off, &program.b[..eq], &program.a);
         let mut vars_of = Vec::new();
         let unbalanced = |c: &Certifier, vars_of: &mut Vec<Var>| {
             job.pieces
