@@ -1072,7 +1072,7 @@ impl<'a> Certifier<'a> {
             for (v, f) in vars.iter().zip(before) {
                 self.f[v.at] = f;
             }
-            if !settled || early == 0.0 {
+            if !settled {
                 break Tried::Trouble;
             }
             // The early iterate did not settle: once more, nearer (a
