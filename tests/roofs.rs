@@ -4,6 +4,8 @@
 
 use std::path::Path;
 
+use crate::common;
+
 use brickwright::assembly::{stairs, verify::verify, Assembly};
 use brickwright::catalog::{Color, Family, Shape};
 use brickwright::grammar::{default_rules, RuleSet};
@@ -208,35 +210,6 @@ fn a_steep_gable_roof_is_capped() {
     check_roof(&path, 20, 0.95);
 }
 
-/// An ellipsoid `a` across, `b` deep and `c` high, as OBJ text (y up),
-/// `n` segments round and `n / 2` rings: a rounded top and a rounded
-/// underside, stepped both ways at once where the surface curves round.
-fn ellipsoid(a: f64, b: f64, c: f64, n: usize) -> String {
-    let rings = n / 2;
-    let mut obj = String::from("o pebble\n");
-    obj += &format!("v 0 {c} 0\n");
-    for i in 1..rings {
-        let t = std::f64::consts::PI * i as f64 / rings as f64;
-        for j in 0..n {
-            let p = 2.0 * std::f64::consts::PI * j as f64 / n as f64;
-            let (x, y, z) = (a * t.sin() * p.cos(), c * t.cos(), b * t.sin() * p.sin());
-            obj += &format!("v {x:.5} {y:.5} {z:.5}\n");
-        }
-    }
-    obj += &format!("v 0 {} 0\n", -c);
-    let at = |i: usize, j: usize| 2 + (i - 1) * n + j % n;
-    let last = 2 + (rings - 1) * n;
-    for j in 0..n {
-        obj += &format!("f 1 {} {}\n", at(1, j + 1), at(1, j));
-        obj += &format!("f {last} {} {}\n", at(rings - 1, j), at(rings - 1, j + 1));
-        for i in 1..rings - 1 {
-            let (p, q, r, s) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
-            obj += &format!("f {p} {q} {r}\nf {p} {r} {s}\n");
-        }
-    }
-    obj
-}
-
 /// On a flat base (the stability stage's relayout where a keel of
 /// inverted slopes tipped a build over), the lowest course has no
 /// inverted slope: it stands on the table on whole bottoms. The pebble's
@@ -245,7 +218,7 @@ fn ellipsoid(a: f64, b: f64, c: f64, n: usize) -> String {
 fn a_flat_base_has_no_inverted_slope_in_its_lowest_course() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("pebble.obj");
-    std::fs::write(&path, ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
+    std::fs::write(&path, common::ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
     let keel = |a: &Assembly| {
         let bottom = a.pieces.iter().map(|p| p.placement.origin.z).min();
         a.pieces
@@ -280,7 +253,7 @@ fn a_flat_base_has_no_inverted_slope_in_its_lowest_course() {
 fn a_rounded_model_is_capped_with_corner_slopes() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("pebble.obj");
-    std::fs::write(&path, ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
+    std::fs::write(&path, common::ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
     let plain = build(&path, 20, false);
     let sloped = build(&path, 20, true);
     let straight_rules = rules(true)
@@ -460,7 +433,7 @@ fn with_plates_bricks_lie_on_courses() {
     // with plates over and under them, they bond (43%, 17.8, 5%).
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("pebble.obj");
-    std::fs::write(&path, ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
+    std::fs::write(&path, common::ellipsoid(8.0, 6.0, 4.0, 32)).unwrap();
     let rules = default_rules()
         .restricted(|p| p.spec().family() != Family::Slope)
         .unwrap();

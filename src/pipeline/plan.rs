@@ -8,7 +8,7 @@ use super::error::cover_error;
 use super::input::Voxels;
 use super::stability::Plan;
 use super::{secs, BuildError, BuildOptions, Progress};
-use crate::assembly::order::by_course;
+use crate::assembly::order::by_course_placeable;
 use crate::assembly::verify::verify;
 use crate::assembly::Assembly;
 use crate::catalog::Color;
@@ -284,11 +284,13 @@ impl<'a> Planner<'a> {
                 report: check.to_string(),
             });
         }
-        let by_course = by_course(&assembly);
-        let (mut assembly, name) = if verify(&by_course, Some(&outcome.voxels)).is_ok() {
-            (by_course, "by course")
-        } else {
-            (assembly, "search trace")
+        // Course by course (mended where that shuts a hung piece in), else
+        // the trace as it is.
+        let (mut assembly, name) = match by_course_placeable(&assembly) {
+            Some(ordered) if verify(&ordered, Some(&outcome.voxels)).is_ok() => {
+                (ordered, "by course")
+            }
+            _ => (assembly, "search trace"),
         };
         assembly.regroup(self.opts.steps);
         Ok((assembly, name))

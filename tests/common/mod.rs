@@ -325,3 +325,32 @@ pub fn prisms(solids: &[Prism]) -> String {
     }
     verts + &faces
 }
+
+/// An ellipsoid `a` across, `b` deep and `c` high, as OBJ text (y up),
+/// `n` segments round and `n / 2` rings: a rounded top and a rounded
+/// underside, stepped both ways at once where the surface curves round.
+pub fn ellipsoid(a: f64, b: f64, c: f64, n: usize) -> String {
+    let rings = n / 2;
+    let mut obj = String::from("o pebble\n");
+    obj += &format!("v 0 {c} 0\n");
+    for i in 1..rings {
+        let t = std::f64::consts::PI * i as f64 / rings as f64;
+        for j in 0..n {
+            let p = 2.0 * std::f64::consts::PI * j as f64 / n as f64;
+            let (x, y, z) = (a * t.sin() * p.cos(), c * t.cos(), b * t.sin() * p.sin());
+            obj += &format!("v {x:.5} {y:.5} {z:.5}\n");
+        }
+    }
+    obj += &format!("v 0 {} 0\n", -c);
+    let at = |i: usize, j: usize| 2 + (i - 1) * n + j % n;
+    let last = 2 + (rings - 1) * n;
+    for j in 0..n {
+        obj += &format!("f 1 {} {}\n", at(1, j + 1), at(1, j));
+        obj += &format!("f {last} {} {}\n", at(rings - 1, j), at(rings - 1, j + 1));
+        for i in 1..rings - 1 {
+            let (p, q, r, s) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
+            obj += &format!("f {p} {q} {r}\nf {p} {r} {s}\n");
+        }
+    }
+    obj
+}
