@@ -549,6 +549,17 @@ pub fn analyze(assembly: &Assembly, params: &Params) -> Result<Analysis, Physics
     analyze_expecting(assembly, params, model::First::Within)
 }
 
+/// Whether the finished build stands, and its analysis when it does
+/// (then [`analyze`]'s): the program within capacity alone; where it has
+/// no answer, the program naming what fails is not solved.
+pub(crate) fn analyze_if_stands(
+    assembly: &Assembly,
+    params: &Params,
+) -> Result<Option<Analysis>, PhysicsError> {
+    let a = analyze_expecting(assembly, params, model::First::Verdict)?;
+    Ok(a.stands().then_some(a))
+}
+
 /// [`analyze`] of a build expected to stand ([`model::First::Within`]) or
 /// to fail ([`model::First::Least`]: no certificate was found for it): the
 /// same answer, in one program where the guess is right.

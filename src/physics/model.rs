@@ -400,6 +400,10 @@ pub(crate) enum First {
     /// The least usage: for a group expected to fail (no certificate was
     /// found for it), whose answer names what fails.
     Least,
+    /// Within capacity alone, for the verdict: a group with no
+    /// equilibrium within capacity is given as falling whole, what fails
+    /// in it not named (the second program, which names it, not solved).
+    Verdict,
 }
 
 /// Solves the group `pieces` (sorted) with the `contacts` among them.
@@ -459,9 +463,15 @@ pub(super) fn solve_until(
             Err(e) => Err(e),
         }
     };
-    if first == First::Within {
+    if first != First::Least {
         if let Some(held) = within()? {
             return Ok(held);
+        }
+        if first == First::Verdict {
+            return Ok(Solved {
+                stress: vec![PieceStress::falling(); pieces.len()],
+                props: Vec::new(),
+            });
         }
         return solve_by(s, pieces, contacts, params, None, method);
     }
@@ -745,6 +755,30 @@ mod tests {
                 assert!(!solved.stress.iter().any(PieceStress::fails));
             }
         }
+    }
+
+    /// The verdict alone: where the model stands, the analysis
+    /// [`crate::physics::analyze`] gives; where it does not, none, with
+    /// one program (the counterweighted overhang without its
+    /// counterweight breaks off).
+    #[test]
+    fn the_verdict_alone_is_the_analysis_where_it_stands_and_none_else() {
+        let params = Params::default();
+        let asm = crate::physics::fixtures::counterweighted();
+        let whole = crate::physics::analyze(&asm, &params).unwrap();
+        assert!(whole.stands());
+        let verdict = crate::physics::analyze_if_stands(&asm, &params)
+            .unwrap()
+            .expect("it stands");
+        assert_eq!(verdict.pieces, whole.pieces);
+        let bare = Assembly {
+            pieces: vec![asm.pieces[0], asm.pieces[2]],
+            layer_ldu: asm.layer_ldu,
+        };
+        assert!(!crate::physics::analyze(&bare, &params).unwrap().stands());
+        assert!(crate::physics::analyze_if_stands(&bare, &params)
+            .unwrap()
+            .is_none());
     }
 
     /// The arch at 24 studs: its linear program shares loads among joints
