@@ -19,10 +19,11 @@
 //! included) and keeps the original order if it still fails.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
+use super::verify::connections;
 use super::{Assembly, Placed};
-use crate::geom::Cell;
+use crate::geom::Body;
 
 /// Mends [`by_course_placeable`] makes at most.
 const MENDS: usize = 24;
@@ -43,14 +44,11 @@ const MEND_SLACK: usize = 10;
 /// broke at step 3).
 pub fn by_course_placeable(assembly: &Assembly) -> Option<Assembly> {
     use super::verify::{verify, Failure};
-    let joins = joins(assembly);
-    let boxes: Vec<_> = assembly
-        .pieces
-        .iter()
-        .map(|p| p.placement.body(assembly.layer_ldu).bbox)
-        .collect();
+    let bodies = bodies(assembly);
+    let joins = connections(&bodies);
+    let boxes: Vec<_> = bodies.iter().map(|b| b.bbox).collect();
     let ground = boxes.iter().map(|b| b.min.z).min().unwrap_or(0);
-    let mut order = course_order(assembly, &joins);
+    let mut order = course_order(assembly, &bodies, &joins);
     let mut most = None;
     for _ in 0..MENDS {
         let ordered = reordered(assembly, &order);
@@ -125,56 +123,28 @@ fn reordered(assembly: &Assembly, order: &[usize]) -> Assembly {
     }
 }
 
-/// The pieces each piece of `assembly` joins by studs, either way.
-fn joins(assembly: &Assembly) -> Vec<Vec<usize>> {
-    let bodies: Vec<_> = assembly
-        .pieces
-        .iter()
-        .map(|p| p.placement.body(assembly.layer_ldu))
-        .collect();
-    // Who takes studs where, and who offers them.
-    let mut tubes: HashMap<Cell, Vec<usize>> = HashMap::new();
-    let mut studs: HashMap<Cell, Vec<usize>> = HashMap::new();
-    for (i, b) in bodies.iter().enumerate() {
-        for c in b.tubes.cells() {
-            tubes.entry(c).or_default().push(i);
-        }
-        for c in b.studs.cells() {
-            studs.entry(c).or_default().push(i);
-        }
-    }
-    (0..bodies.len())
-        .map(|i| {
-            let b = &bodies[i];
-            let mut out: Vec<usize> = b
-                .over_studs()
-                .cells()
-                .flat_map(|c| tubes.get(&c).into_iter().flatten().copied())
-                .filter(|&j| b.holds(&bodies[j]))
-                .chain(
-                    b.under_tubes()
-                        .cells()
-                        .flat_map(|c| studs.get(&c).into_iter().flatten().copied())
-                        .filter(|&j| bodies[j].holds(b)),
-                )
-                .filter(|&j| j != i)
-                .collect();
-            out.sort_unstable();
-            out.dedup();
-            out
-        })
-        .collect()
-}
-
 /// The assembly's pieces in course-by-course order, steps renumbered one
 /// piece a step (regroup afterwards).
 pub fn by_course(assembly: &Assembly) -> Assembly {
-    reordered(assembly, &course_order(assembly, &joins(assembly)))
+    let bodies = bodies(assembly);
+    reordered(
+        assembly,
+        &course_order(assembly, &bodies, &connections(&bodies)),
+    )
 }
 
-/// [`by_course`]'s order, as indices into `assembly`'s pieces; `joins` is
-/// [`joins`]'s.
-fn course_order(assembly: &Assembly, joins: &[Vec<usize>]) -> Vec<usize> {
+/// The pieces' bodies.
+fn bodies(assembly: &Assembly) -> Vec<Body> {
+    assembly
+        .pieces
+        .iter()
+        .map(|p| p.placement.body(assembly.layer_ldu))
+        .collect()
+}
+
+/// [`by_course`]'s order, as indices into `assembly`'s pieces, whose
+/// `bodies` are stud-connected as `joins` says ([`connections`]).
+fn course_order(assembly: &Assembly, bodies: &[Body], joins: &[Vec<usize>]) -> Vec<usize> {
     let n = assembly.pieces.len();
     let layer_ldu = assembly.layer_ldu;
     let course = |i: usize| (assembly.pieces[i].placement.origin.z * layer_ldu).div_euclid(24);
@@ -185,14 +155,9 @@ fn course_order(assembly: &Assembly, joins: &[Vec<usize>]) -> Vec<usize> {
     let mut next_seed = 0;
     // Everything on the ground can start at once: a person lays the bottom
     // course on the table before building on it.
-    let bottoms: Vec<i32> = assembly
-        .pieces
-        .iter()
-        .map(|p| p.placement.body(layer_ldu).bbox.min.z)
-        .collect();
-    let ground = bottoms.iter().copied().min().unwrap_or(0);
-    for (i, &bottom) in bottoms.iter().enumerate() {
-        if bottom == ground {
+    let ground = bodies.iter().map(|b| b.bbox.min.z).min().unwrap_or(0);
+    for (i, b) in bodies.iter().enumerate() {
+        if b.bbox.min.z == ground {
             queued[i] = true;
             heap.push(Reverse((course(i), i)));
         }
@@ -228,7 +193,7 @@ mod tests {
     use crate::assembly::verify::verify;
     use crate::assembly::Placement;
     use crate::catalog::{Color, PartKind};
-    use crate::geom::Rot;
+    use crate::geom::{Cell, Rot};
 
     #[test]
     fn a_zigzag_trace_is_built_course_by_course() {
