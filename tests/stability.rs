@@ -448,6 +448,17 @@ fn the_order_repair_puts_the_counterweight_before_the_overhang() {
     assert!(verify(&fixed.assembly, None).is_ok());
     let again = analyze_steps(&fixed.assembly, &params, false).unwrap();
     assert_eq!(again.first_failure, None, "{again:?}");
+    // Every step the walk kept was certified: its certificates are the
+    // new order's check from step 2 on, with the verdicts of the check
+    // made again.
+    let walked = fixed.walked.as_ref().expect("every step certified");
+    let verdicts = |c: &[brickwright::physics::StepCheck]| {
+        c.iter().map(|c| (c.step, c.stands)).collect::<Vec<_>>()
+    };
+    assert_eq!(verdicts(&walked.steps), verdicts(&again.steps[1..]));
+    assert_eq!(verdicts(&walked.steps), [(2, true)]);
+    assert!(walked.last.stands(), "{walked:?}");
+    assert_eq!(walked.last.pieces.len(), 3);
 }
 
 #[test]
@@ -522,4 +533,52 @@ fn the_order_repair_gives_up_once_more_pieces_wait_than_a_step_may_hold() {
         "{} trials for a column of {column}",
         trials.get()
     );
+}
+
+#[test]
+fn an_order_repaired_build_reports_the_repair_and_every_step_stands_checked_again() {
+    // A pebble three times as wide as it is deep and high, at 32 studs:
+    // course by course, a 1 x 8 at step 2 hangs out past what holds it;
+    // the order repair builds it a step later. Every step the repair's
+    // walk kept was certified, and those certificates are the new order's
+    // check: checked again here, and each step solved whole.
+    use brickwright::ldraw::{read_ldr, to_assembly};
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = tmp.path().join("pebble.obj");
+    std::fs::write(&mesh, common::ellipsoid(3.0, 1.0, 1.0, 32)).unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&mesh, "32", &out, &["--formats", "ldr"]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let r = report(&out);
+    let st = &r["stability"];
+    assert_eq!(st["stands"], true, "{st}");
+    let moved = st["moved"].as_array().unwrap();
+    assert!(!moved.is_empty(), "{st}");
+    // The report says what was repaired, and how it stood before.
+    let repairs = st["repairs"].as_array().unwrap();
+    assert!(
+        repairs
+            .iter()
+            .any(|x| x.as_str().unwrap().starts_with("order: ")),
+        "{st}"
+    );
+    let before = st["before"]["first_failure"].as_u64().unwrap();
+    assert!(before >= 1, "{st}");
+    let model = read_ldr(&out.join("pebble.ldr")).unwrap();
+    let asm = to_assembly(&model).unwrap();
+    let params = Params::default();
+    let again = analyze_steps(&asm, &params, false).unwrap();
+    assert_eq!(again.first_failure, None, "{again:?}");
+    let steps = st["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), again.steps.len());
+    for (reported, check) in steps.iter().zip(&again.steps) {
+        assert_eq!(reported["step"].as_u64(), Some(u64::from(check.step)));
+        assert_eq!(reported["stands"], true);
+        let whole = brickwright::physics::analyze(&asm.through_step(check.step), &params).unwrap();
+        assert!(whole.stands(), "step {}", check.step);
+    }
 }

@@ -154,11 +154,15 @@ pub(super) struct Structure {
 }
 
 /// How far the programs of a [`Structure`] went: iterations in all, and
-/// of the one being solved (shared with whoever waits for them).
+/// of the one being solved (shared with whoever waits for them); and
+/// whether a group's program within capacity has answered that it has no
+/// equilibrium (the structure fails, before the program of least usage
+/// says what fails in it).
 #[derive(Debug, Default)]
 pub struct Progress {
     pub total: std::sync::atomic::AtomicU32,
     pub current: std::sync::atomic::AtomicU32,
+    pub fails: std::sync::atomic::AtomicBool,
 }
 
 impl Structure {
@@ -453,13 +457,22 @@ pub(super) fn solve_until(
             hands: false,
             ..method
         };
-        match solve_by(s, pieces, contacts, params, Some(&held), bare) {
+        let r = solve_by(s, pieces, contacts, params, Some(&held), bare);
+        match r {
             Ok(held) if !held.stress.iter().any(PieceStress::fails) => Ok(Some(held)),
             // Stopped (its answer no longer wanted): so would the other.
             Err(e @ PhysicsError::Solver { .. }) if late() => Err(e),
             // No answer within capacity (or the solver's trouble): the
-            // other program says.
-            Ok(_) | Err(PhysicsError::Solver { .. }) => Ok(None),
+            // other program says. The solver's proof that there is none
+            // is told at once (see [`Progress::fails`]).
+            Ok(_) | Err(PhysicsError::Solver { .. }) => {
+                if let (Some(p), Err(PhysicsError::Solver { status, .. })) = (&s.progress, &r) {
+                    if status.ends_with("PrimalInfeasible") {
+                        p.fails.store(true, std::sync::atomic::Ordering::Relaxed);
+                    }
+                }
+                Ok(None)
+            }
             Err(e) => Err(e),
         }
     };

@@ -15,8 +15,13 @@
 //! does the full force analysis ([`analyze`](super::analyze)) say which pieces fail.
 //! Nothing is accepted on a guess.
 //!
-//! The caller verifies the new order (connection and placeability) and
-//! checks every step again with [`analyze_steps`](super::analyze_steps).
+//! The caller verifies the new order (connection and placeability). Where
+//! every step the walk kept was certified so (from the first failure to
+//! the end, nothing left waiting), those certificates are the check of the
+//! new order's steps ([`Reordered::walked`]): a step is said to stand only
+//! on an equilibrium checked against every equation and bound, as the
+//! step check says it. Otherwise the caller checks every step again with
+//! [`analyze_steps`](super::analyze_steps).
 
 use std::collections::BTreeSet;
 
@@ -24,7 +29,8 @@ use serde::Serialize;
 
 use super::certify::{Certifier, Verdict};
 use super::model::{First, Structure};
-use super::{analyze_expecting, Analysis, Params, PhysicsError};
+use super::steps::check;
+use super::{analyze_expecting, Analysis, Params, PhysicsError, PieceStress, StepCheck};
 use crate::assembly::verify::Placing;
 use crate::assembly::{Assembly, Placed, Step};
 
@@ -53,6 +59,22 @@ pub struct Reordered {
     pub solves: usize,
     /// Candidate steps certified standing without one.
     pub certified: usize,
+    /// The new order's steps from the first failure on, each certified
+    /// standing by the walk; `None` where one was not (a step the full
+    /// analysis held, or pieces still waiting at the end).
+    pub walked: Option<Walked>,
+}
+
+/// The walk's check of the steps it certified (see [`Reordered::walked`]).
+#[derive(Debug, Clone)]
+pub struct Walked {
+    /// A check for each step of the new order from the first failure on,
+    /// as the step check gives it: every one stands.
+    pub steps: Vec<StepCheck>,
+    /// Each piece's stress (in the new order) in the equilibrium that
+    /// certified its group at the last step: the finished model stands
+    /// (its `solve_seconds` the walk's).
+    pub last: Analysis,
 }
 
 /// Candidate steps a reorder may check, per step of the build, at most; a
@@ -100,6 +122,7 @@ pub fn reorder_while(
     first_failure: u32,
     go: &dyn Fn() -> bool,
 ) -> Result<Option<Reordered>, PhysicsError> {
+    let started_at = std::time::Instant::now();
     let n = assembly.pieces.len();
     let bodies: Vec<_> = assembly
         .pieces
@@ -137,6 +160,10 @@ pub fn reorder_while(
     let mut deferred: BTreeSet<usize> = BTreeSet::new();
     let mut was_deferred = vec![false; n];
     let mut solves = 0;
+    // Each piece's stress in the equilibrium kept, and the new steps'
+    // checks made of them.
+    let mut current = vec![PieceStress::falling(); n];
+    let mut checks: Vec<StepCheck> = Vec::new();
     for group in groups {
         let step = assembly.pieces[group[0]].step.0;
         if step < first_failure {
@@ -153,7 +180,7 @@ pub fn reorder_while(
             started = true;
             let mut all = placed.clone();
             all.sort_unstable();
-            certain = holds(&mut cert, &all);
+            certain = holds(&mut cert, &all, &mut current);
         }
         let mut trial: BTreeSet<usize> = deferred.iter().copied().chain(group).collect();
         let mut held: BTreeSet<usize> = BTreeSet::new();
@@ -176,7 +203,7 @@ pub fn reorder_while(
             }
             let mut new = kept.clone();
             new.sort_unstable();
-            let failing = if certain && holds(&mut cert, &new) {
+            let failing = if certain && holds(&mut cert, &new, &mut current) {
                 certified += 1;
                 Vec::new()
             } else {
@@ -216,6 +243,10 @@ pub fn reorder_while(
                     placing.add(&bodies[i].bbox);
                 }
                 steps.push(kept);
+                if certain {
+                    let now: Vec<PieceStress> = placed.iter().map(|&i| current[i]).collect();
+                    checks.push(check(steps.len() as u32, &now));
+                }
                 break;
             }
             for i in failing {
@@ -240,6 +271,14 @@ pub fn reorder_while(
         }
         deferred = trial;
     }
+    // Certified at every step to the end, the walk is the new order's check.
+    let walked = (certain && deferred.is_empty()).then(|| Walked {
+        steps: checks,
+        last: Analysis::new(
+            placed.iter().map(|&i| current[i]).collect(),
+            started_at.elapsed().as_secs_f64(),
+        ),
+    });
     if !deferred.is_empty() {
         // Whatever never stood is added at the end, as it was: the final
         // check reports it.
@@ -301,15 +340,30 @@ pub fn reorder_while(
         moved,
         solves,
         certified,
+        walked,
     }))
 }
 
 /// Whether every group of `cert`'s placed pieces that holds a piece of
-/// `new` (sorted) stands, its kept equilibrium changed to hold them.
-fn holds(cert: &mut Certifier, new: &[usize]) -> bool {
-    cert.groups_with(new)
-        .iter()
-        .all(|(job, mine)| job.grounded && matches!(cert.certify(job, mine), Verdict::Stands(_)))
+/// `new` (sorted) stands, its kept equilibrium changed to hold them; if
+/// so, their pieces' stresses in it go into `current`.
+fn holds(cert: &mut Certifier, new: &[usize], current: &mut [PieceStress]) -> bool {
+    let mut found = Vec::new();
+    for (job, mine) in cert.groups_with(new) {
+        if !job.grounded {
+            return false;
+        }
+        match cert.certify(&job, &mine) {
+            Verdict::Stands(stress) => found.push((job.pieces, stress)),
+            _ => return false,
+        }
+    }
+    for (pieces, stress) in found {
+        for (p, st) in pieces.into_iter().zip(stress) {
+            current[p] = st;
+        }
+    }
+    true
 }
 
 /// The pieces of `trial` that join what is built, in order: each stands

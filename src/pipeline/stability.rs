@@ -224,8 +224,14 @@ pub fn settle(
         tell,
         None,
     )?;
+    // Before any repair: an order repair kept in the first attempt has
+    // made its check stand where the first failed.
+    let unrepaired_failure = first
+        .check
+        .first_failure
+        .or(first.order_fix.as_ref().and(first.order_tried));
     let mut before = Before {
-        first_failure: first.check.first_failure,
+        first_failure: unrepaired_failure,
         min_score: None,
         final_stands: None,
     };
@@ -722,35 +728,51 @@ fn attempt(
         // on a big build it may not finish, and must leave time for the
         // support columns.
         // While the finished model's analysis is being made, the repair
-        // goes on beside it, and gives up once it says the model fails.
+        // goes on beside it, and gives up once it knows the model fails
+        // (a group's program within capacity has no answer: the repair is
+        // kept only if the model stands).
         let now = Instant::now();
         let share = now + deadline.saturating_duration_since(now) / ORDER_SHARE;
         let pending = at.pending.clone();
-        let go = || {
-            Instant::now() < share
-                && pending
-                    .as_ref()
-                    .is_none_or(|p| p.stands().is_none_or(|stands| stands))
-        };
+        let go = || Instant::now() < share && pending.as_ref().is_none_or(|p| !p.known_to_fail());
         if let Some(r) = reorder_while(&at.plan.1, params, step, &go)? {
             counts.solves += r.solves;
             counts.certified += r.certified;
             if verify(&r.assembly, Some(&at.plan.0.voxels)).is_ok() {
-                let c = analyze_steps_verdicts(
-                    &r.assembly,
-                    params,
-                    true,
-                    Some(deadline),
-                    1,
-                    None,
-                    Finish::WhenDue,
-                )?;
-                counts.add(&c);
+                // The walk's certificates, where it certified every step
+                // it kept; else every step checked again.
+                let c = match walked(&at.check, step, &r) {
+                    Some(c) => c,
+                    None => {
+                        let c = analyze_steps_verdicts(
+                            &r.assembly,
+                            params,
+                            true,
+                            Some(deadline),
+                            1,
+                            None,
+                            Finish::WhenDue,
+                        )?;
+                        counts.add(&c);
+                        c
+                    }
+                };
                 if c.complete && later(c.first_failure, at.check.first_failure) {
-                    // Kept only if the finished model stands: known within
-                    // the grace after the deadline, or not kept.
+                    // Kept only if the finished model stands: certified at
+                    // the last step, or known within the grace after the
+                    // deadline, or not kept. A model too big for its map
+                    // to be the program's does not wait for that program
+                    // once its last step is certified (the bunny at 60
+                    // studs, 3,061 pieces: the program of its pieces in
+                    // the order before is dropped).
                     let until = deadline + GRACE;
-                    if at
+                    let certified = c.first_failure.is_none()
+                        && at.finished.is_none()
+                        && at.plan.1.pieces.len() > MAP_PIECES;
+                    if certified {
+                        at.pending = None;
+                        order_kept(&mut at, r, c)?;
+                    } else if at
                         .finished_by(params, until, counts)?
                         .is_some_and(Analysis::stands)
                     {
@@ -782,18 +804,55 @@ fn order_kept(
     c: StepsAnalysis,
 ) -> Result<(), crate::pipeline::BuildError> {
     // The same pieces in another order: the finished model's analysis
-    // follows it.
-    let finished = at
-        .finished
-        .as_ref()
-        .and_then(|f| reindexed(f, &at.plan.1, &r.assembly))
-        .ok_or_else(|| PhysicsError::Bug("the order repair lost a piece".into()))?;
-    at.finished = Some(finished);
+    // follows it (when made: else the check certified it).
+    if let Some(f) = &at.finished {
+        let finished = reindexed(f, &at.plan.1, &r.assembly)
+            .ok_or_else(|| PhysicsError::Bug("the order repair lost a piece".into()))?;
+        at.finished = Some(finished);
+    }
     at.order_fix = Some(r.moved);
     at.plan.1 = r.assembly;
     at.partial = stopped_early(&at.plan.1, &c);
     at.check = c;
     Ok(())
+}
+
+/// The check of the order repair `r` of a build whose check `first`
+/// stopped at its first failure, `step`, made of the walk's certificates
+/// (see [`crate::physics::repair::Reordered::walked`]): the first
+/// check's steps before `step` (the same pieces in the same steps), then
+/// the walk's. `None` where the walk did not certify every step it kept.
+fn walked(
+    first: &StepsAnalysis,
+    step: u32,
+    r: &crate::physics::repair::Reordered,
+) -> Option<StepsAnalysis> {
+    let w = r.walked.as_ref()?;
+    let mut steps: Vec<_> = first
+        .steps
+        .iter()
+        .take_while(|c| c.step < step)
+        .cloned()
+        .collect();
+    steps.extend(w.steps.iter().cloned());
+    // Numbered 1, 2, ... as the new order's steps are.
+    let numbered = steps.iter().zip(1..).all(|(c, k)| c.step == k)
+        && r.assembly.pieces.last().map(|p| p.step.0) == Some(steps.len() as u32)
+        && w.last.pieces.len() == r.assembly.pieces.len();
+    numbered.then(|| StepsAnalysis {
+        steps,
+        first_failure: None,
+        last: w.last.clone(),
+        seconds: 0.0,
+        solves: 0,
+        reused: 0,
+        certified: 0,
+        whole_certified: 0,
+        failures_carried: 0,
+        complete: true,
+        finished: None,
+        map: StressMap::Certificates,
+    })
 }
 
 /// `a`, an analysis of the pieces of `before`, in the order of `after`
