@@ -1358,8 +1358,15 @@ impl<'a> Certifier<'a> {
         let near = move |i: &clarabel::solver::DefaultInfo<f64>| {
             i.iterations > 0 && i.res_primal < early && i.ktratio < early
         };
+        // Stopped with the structure's other programs (its answer no
+        // longer wanted: see `Structure::stop`).
+        let stop = self.s.stop.clone();
         solver.set_termination_callback(move |i| {
-            near(i) || deadline.is_some_and(|d| std::time::Instant::now() >= d)
+            near(i)
+                || deadline.is_some_and(|d| std::time::Instant::now() >= d)
+                || stop
+                    .as_ref()
+                    .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
         });
         solver.solve();
         match solver.solution.status {

@@ -271,6 +271,8 @@ pub fn analyze_steps_told(
         from,
         tell,
         map: true,
+        before: None,
+        cancel: None,
     };
     check_steps(&ask, Finish::WhenDue)
 }
@@ -354,6 +356,8 @@ fn check_asked(
         from,
         tell,
         map,
+        before: None,
+        cancel: None,
     };
     check_steps(&ask, finish)
 }
@@ -369,6 +373,14 @@ struct Ask<'a> {
     /// A complete check solves the structure it ends at for its map
     /// (else the map is the certificates', see [`analyze_steps_verdicts`]).
     map: bool,
+    /// The first half of a split check (see [`check_split`]): the steps
+    /// before this one (an index into the steps) only, with nothing of
+    /// the finished model's.
+    before: Option<usize>,
+    /// Set when the other half of a split check has found what this half
+    /// would not change: this half stops at its next step.
+    /// Its programs stop too (it is the check's structure's stop flag).
+    cancel: Option<&'a std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// When a step check makes the finished model's analysis
@@ -636,12 +648,157 @@ fn lost() -> PhysicsError {
 
 /// [`analyze_steps_told`], and with `finish` [`analyze_steps_with_finished`].
 fn check_steps(ask: &Ask, finish: Finish) -> Result<StepsAnalysis, PhysicsError> {
+    if let Some(mid) = split_at(ask) {
+        return check_split(ask, finish, mid);
+    }
+    check_whole(ask, finish)
+}
+
+/// Pieces a check must have past its first step for [`check_split`].
+const SPLIT_PIECES: usize = 800;
+
+/// How a step's cost in a split check is taken to grow with the pieces
+/// placed (see [`split_at`]): suzanne at 60 studs (its support round's
+/// check of 1,513 pieces from step 26), split at half its pieces, took 4.4
+/// s for its first half and 7.9 s for its later one (which begins with a
+/// program of everything before it, and shares its core with the finished
+/// model's analysis for a while); at a split for a cost growing as the
+/// pieces (power 2), 6.6 s and 4.9 s.
+const SPLIT_POWER: f64 = 1.5;
+
+/// Steps each half of a split check has at least.
+const SPLIT_STEPS: usize = 24;
+
+/// Where [`check_split`] splits `ask`'s check (an index into its steps),
+/// if it does: a check of many steps whose later half, begun afresh, can
+/// go on beside the first on a core of its own.
+fn split_at(ask: &Ask) -> Option<(usize, u32)> {
+    if ask.before.is_some()
+        || rayon::current_thread_index().is_some()
+        || rayon::current_num_threads() < 2
+    {
+        return None;
+    }
+    let pieces = &ask.assembly.pieces;
+    // Each step's end, in build order.
+    let mut ends: Vec<(u32, usize)> = Vec::new();
+    for (i, p) in pieces.iter().enumerate() {
+        match ends.last_mut() {
+            Some((step, end)) if *step == p.step.0 => *end = i + 1,
+            _ => ends.push((p.step.0, i + 1)),
+        }
+    }
+    let k0 = ends.iter().position(|e| e.0 >= ask.from)?;
+    let first = if k0 == 0 { 0 } else { ends[k0 - 1].1 };
+    let n = pieces.len();
+    if n - first < SPLIT_PIECES || ends.len() - k0 < 2 * SPLIT_STEPS {
+        return None;
+    }
+    // A step's programs grow with the pieces placed: with the cost of a
+    // step taken as its pieces so far to the power SPLIT_POWER, each half
+    // has as much (see [`SPLIT_POWER`]).
+    let weight = |x: usize| (x as f64).powf(SPLIT_POWER);
+    let half = ((weight(first) + weight(n)) / 2.0).powf(1.0 / SPLIT_POWER) as usize;
+    let mid = ends.iter().position(|e| e.1 >= half)?;
+    (mid >= k0 + SPLIT_STEPS && ends.len() - mid >= SPLIT_STEPS).then_some((mid, ends[mid].0))
+}
+
+/// `ask`'s check in two halves, on two cores: the steps before `mid`
+/// (an index into the steps; its step number `mid_step`) as [`check_whole`] checks them, and beside
+/// them the steps from `mid` on, begun with every group of the structure
+/// at `mid` certified whole (or solved, where it fails) and going on as
+/// any check does. The two give the same verdicts as one check (each is
+/// a verdict of its step, whatever equilibrium certified the step
+/// before); the equilibria the later half keeps differ from one check's,
+/// the same on every run. Where the first half fails and the check stops
+/// at its first failure, the later half is stopped and dropped.
+fn check_split(
+    ask: &Ask,
+    finish: Finish,
+    (mid, mid_step): (usize, u32),
+) -> Result<StepsAnalysis, PhysicsError> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let start = Instant::now();
+    let cancel = std::sync::Arc::new(AtomicBool::new(false));
+    let (assembly, params, stop, deadline, map) = (
+        ask.assembly,
+        ask.params,
+        ask.stop_at_first_failure,
+        ask.deadline,
+        ask.map,
+    );
+    let cancel_ref = &cancel;
+    let (first, later) = std::thread::scope(|scope| {
+        let later = scope.spawn(move || {
+            let ask = Ask {
+                assembly,
+                params,
+                stop_at_first_failure: stop,
+                deadline,
+                from: mid_step,
+                tell: None,
+                map,
+                before: None,
+                cancel: Some(cancel_ref),
+            };
+            check_whole(&ask, finish)
+        });
+        let first = check_whole(
+            &Ask {
+                before: Some(mid),
+                map: false,
+                ..*ask
+            },
+            Finish::WhenDue,
+        );
+        // Its failure is the check's: the later half is not wanted.
+        if stop && first.as_ref().map_or(true, |a| a.first_failure.is_some()) {
+            cancel.store(true, Ordering::Relaxed);
+        }
+        let later = later.join().unwrap_or_else(|_| {
+            Err(PhysicsError::Bug(
+                "a half of the step check panicked".into(),
+            ))
+        });
+        (first, later)
+    });
+    let (a, b) = (first?, later?);
+    let fails_first = a.first_failure.is_some();
+    if !a.complete || (stop && fails_first) {
+        // Stopped in the first half: its check, the later half's work
+        // dropped (the finished model's analysis kept, when made).
+        return Ok(StepsAnalysis {
+            seconds: start.elapsed().as_secs_f64(),
+            finished: b.finished,
+            ..a
+        });
+    }
+    let mut steps = a.steps;
+    steps.extend(b.steps);
+    Ok(StepsAnalysis {
+        steps,
+        first_failure: a.first_failure.or(b.first_failure),
+        last: b.last,
+        seconds: start.elapsed().as_secs_f64(),
+        solves: a.solves + b.solves,
+        reused: a.reused + b.reused,
+        certified: a.certified + b.certified,
+        whole_certified: a.whole_certified + b.whole_certified,
+        failures_carried: a.failures_carried + b.failures_carried,
+        complete: b.complete,
+        finished: b.finished,
+        map: b.map,
+    })
+}
+
+/// [`check_steps`] in one go.
+fn check_whole(ask: &Ask, finish: Finish) -> Result<StepsAnalysis, PhysicsError> {
     let start = Instant::now();
     ask.params.check()?;
     let mut s = Structure::new(ask.assembly, ask.params);
     // Set once a check cut short by its deadline gives up the finished
     // model's programs still running (the steps' own are done by then).
-    s.stop = Some(Default::default());
+    s.stop = Some(ask.cancel.cloned().unwrap_or_default());
     rayon::in_place_scope(|scope| {
         let mut fin = Finisher::new(scope, &s, ask.params, ask.assembly.pieces.len(), finish);
         check_steps_in(ask, &s, start, &mut fin)
@@ -664,8 +821,16 @@ fn check_steps_in(
         from,
         tell,
         map,
+        before,
+        cancel,
     } = *ask;
     let n = assembly.pieces.len();
+    // The first half of a split check has nothing of the finished model's
+    // to make room for.
+    let half = before.is_some();
+    // Stopped by the other half (see [`Ask::cancel`]): nothing more made.
+    let mut cancelled = false;
+    let stopped = || cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed));
     // (step number, end of its pieces in build order).
     let mut bounds: Vec<(u32, usize)> = Vec::new();
     for (i, p) in assembly.pieces.iter().enumerate() {
@@ -707,13 +872,26 @@ fn check_steps_in(
         if let Some(tell) = tell {
             tell(k as u64, total);
         }
+        if before.is_some_and(|b| k >= b) {
+            break;
+        }
+        if stopped() {
+            complete = false;
+            cancelled = true;
+            break;
+        }
         if k < k0 {
             begin = end;
             continue;
         }
         if k == k0 && k0 > 0 {
             window.skip_to(k + 1);
-            if past(fin.cut(&reserve, deadline, start, true)?) {
+            let cut = if half {
+                deadline
+            } else {
+                fin.cut(&reserve, deadline, start, true)?
+            };
+            if past(cut) {
                 complete = false;
                 break;
             }
@@ -723,22 +901,49 @@ fn check_steps_in(
             } else {
                 None
             };
-            let whole = match made {
+            match made {
                 Some((whole, secs)) => {
                     step_seconds = secs;
-                    whole
+                    current[..end].copy_from_slice(&whole);
+                    exact[..end].fill(true);
                 }
                 None => {
+                    // Each group of it certified whole (the kept forces
+                    // the steps after change); the programs name what
+                    // fails in the others.
                     let begun = Instant::now();
-                    let whole = solve_all(s, end, params)?;
+                    let (mut g, mut next, mut none) = (Groups::new(), 0, 0);
+                    let jobs = jobs_for_step(s, &mut g, &mut next, end, &mut none);
+                    cert.place_to(end);
+                    let mut late = Vec::new();
+                    for job in &jobs {
+                        if job.grounded
+                            && take_certificate(&mut cert, job, 0, &mut current, &mut exact)
+                        {
+                            certified += 1;
+                        } else {
+                            late.push(job);
+                        }
+                    }
+                    let results = match run_refs(s, &late, params, First::Least, deadline) {
+                        Err(PhysicsError::Solver { .. }) if past(deadline) || stopped() => {
+                            complete = false;
+                            cancelled = stopped();
+                            break;
+                        }
+                        r => r?,
+                    };
+                    solves += results.iter().filter(|r| r.1 == Found::Solved).count();
+                    for (job, (r, found, secs)) in late.iter().zip(results) {
+                        reserve.note(job.pieces.len(), found, secs);
+                        for (&p, st) in job.pieces.iter().zip(r) {
+                            current[p] = st;
+                            exact[p] = true;
+                        }
+                    }
                     step_seconds = begun.elapsed().as_secs_f64();
-                    reserve.note(end, Found::Solved, step_seconds);
-                    solves += 1;
-                    whole
                 }
-            };
-            current[..end].copy_from_slice(&whole);
-            exact[..end].fill(true);
+            }
             steps.push(check(step, &current[..end]));
             begin = end;
             if !steps[steps.len() - 1].stands {
@@ -751,7 +956,12 @@ fn check_steps_in(
         }
         // The finished model's analysis, if not made yet, starts by the
         // time it takes before the deadline, so that the two end near it.
-        if past(fin.cut(&reserve, deadline, start, true)?) {
+        let cut = if half {
+            deadline
+        } else {
+            fin.cut(&reserve, deadline, start, true)?
+        };
+        if past(cut) {
             complete = false;
             break;
         }
@@ -817,7 +1027,12 @@ fn check_steps_in(
         // Not started once the last step's programs are solved or about
         // to be: it would solve them again.
         let due = k != last_k;
-        if !late.is_empty() && past(fin.cut(&reserve, deadline, start, due)?) {
+        let cut = if half || late.is_empty() {
+            deadline
+        } else {
+            fin.cut(&reserve, deadline, start, due)?
+        };
+        if !late.is_empty() && past(cut) {
             complete = false;
             break;
         }
@@ -826,8 +1041,9 @@ fn check_steps_in(
         // pieces at step 189 took its check 28 s past it), and the check
         // is then cut there.
         let results = match run_refs(s, &late, params, First::Least, deadline) {
-            Err(PhysicsError::Solver { .. }) if past(deadline) => {
+            Err(PhysicsError::Solver { .. }) if past(deadline) || stopped() => {
                 complete = false;
+                cancelled = stopped();
                 break;
             }
             r => r?,
@@ -850,6 +1066,24 @@ fn check_steps_in(
                 break;
             }
         }
+    }
+    if half || cancelled {
+        // The first half, or a later half stopped: its steps, and the
+        // structure it ended at.
+        return Ok(StepsAnalysis {
+            steps,
+            first_failure,
+            last: Analysis::new(current[..begin].to_vec(), step_seconds),
+            seconds: start.elapsed().as_secs_f64(),
+            solves,
+            reused,
+            certified,
+            whole_certified: cert.found[cert.found.len() - 1],
+            failures_carried: carried,
+            complete,
+            finished: None,
+            map: StressMap::Checked,
+        });
     }
     // The steps not reached still count their groups that did not grow.
     let reused = reused + window.finish();
@@ -953,6 +1187,92 @@ pub(super) fn check(step: u32, placed: &[PieceStress]) -> StepCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::assembly::{Placed, Placement, Step};
+    use crate::catalog::{Color, PartKind};
+    use crate::geom::{Cell, Rot};
+
+    /// A wall one stud deep and 32 long, of 1 x 4 bricks in running bond,
+    /// `courses` high, a course a step; and a 1 x 1 brick in the air, with
+    /// nothing under or over it, at step `floating` (it falls there and
+    /// at every step after).
+    fn wall(courses: i32, floating: Option<u32>) -> Assembly {
+        let brick = |id: &str, x: i32, z: i32, step: u32| Placed {
+            placement: Placement::new(PartKind::from_id(id).unwrap(), Cell::new(x, 0, z), Rot::R0),
+            step: Step(step),
+            color: Color::RED,
+        };
+        let mut pieces = Vec::new();
+        for z in 0..courses {
+            let step = z as u32 + 1;
+            let xs: Vec<i32> = if z % 2 == 0 {
+                (0..8).map(|i| 4 * i).collect()
+            } else {
+                (0..7).map(|i| 4 * i + 2).collect()
+            };
+            pieces.extend(xs.into_iter().map(|x| brick("3010", x, z, step)));
+            if floating == Some(step) {
+                pieces.push(brick("3005", 40, z + 3, step));
+            }
+        }
+        Assembly {
+            pieces,
+            layer_ldu: 24,
+        }
+    }
+
+    fn ask(asm: &Assembly, params: &Params, stop: bool, from: u32) -> Ask<'static> {
+        // Leaked for the test: an `Ask` borrows what it checks.
+        let asm: &'static Assembly = Box::leak(Box::new(asm.clone()));
+        let params: &'static Params = Box::leak(Box::new(*params));
+        Ask {
+            assembly: asm,
+            params,
+            stop_at_first_failure: stop,
+            deadline: None,
+            from,
+            tell: None,
+            map: false,
+            before: None,
+            cancel: None,
+        }
+    }
+
+    #[test]
+    fn a_check_split_in_two_halves_gives_the_verdicts_of_one() {
+        let params = Params::default();
+        let verdicts = |c: &StepsAnalysis| {
+            c.steps
+                .iter()
+                .map(|c| (c.step, c.stands))
+                .collect::<Vec<_>>()
+        };
+        for (floating, stop, from) in [
+            (None, false, 1),
+            (None, true, 12),
+            (Some(20), true, 1),
+            (Some(20), false, 1),
+            (Some(90), true, 1),
+            (Some(90), false, 5),
+        ] {
+            let asm = wall(130, floating);
+            assert!(asm.pieces.len() >= SPLIT_PIECES);
+            let a = ask(&asm, &params, stop, from);
+            // Split where the pool has two workers or more, as on CI.
+            let split = split_at(&a);
+            assert_eq!(split.is_some(), rayon::current_num_threads() > 1);
+            let (mid, mid_step) = split.unwrap_or((60, 61));
+            assert!(mid > 40 && mid < 110, "{mid}");
+            let one = check_whole(&a, Finish::WhenDue).unwrap();
+            let two = check_split(&a, Finish::WhenDue, (mid, mid_step)).unwrap();
+            let case = (floating, stop, from);
+            assert_eq!(two.first_failure, one.first_failure, "{case:?}");
+            assert_eq!(one.first_failure, floating, "{case:?}");
+            assert_eq!(verdicts(&two), verdicts(&one), "{case:?}");
+            assert!(two.complete && one.complete, "{case:?}");
+            assert_eq!(two.last.pieces.len(), one.last.pieces.len(), "{case:?}");
+            assert_eq!(two.last.stands(), one.last.stands(), "{case:?}");
+        }
+    }
 
     #[test]
     fn the_reserve_grows_with_the_model_from_the_biggest_program_solved() {
