@@ -128,6 +128,13 @@
 //! is used there only when it is given, made already: waiting for it
 //! took 150 s on a 5,000-piece build whose steps took 45 s, and a verdict
 //! taken from whichever ended first would move with the machine's load).
+//! A check begun at a later step certifies each group there whole first.
+//! A long check (48 steps and 800 pieces or more, its later half begun
+//! under 1,500 pieces) runs in two halves on two cores, the later one
+//! begun afresh with the structure at its first step certified whole:
+//! each verdict is its step's, whatever equilibrium certified the step
+//! before, so the halves give one check's verdicts (their kept equilibria
+//! differ, the same on every run: the split is a function of the steps).
 //! The finished build is solved afresh with the force program, for the
 //! usage of every piece: one answer, the same from [`analyze`] and from a
 //! step check given it, within 1e-6 (the program within capacity first,
