@@ -966,22 +966,21 @@ fn check_steps_in(
                             late.push(job);
                         }
                     }
-                    let results = match run_refs(s, &late, params, First::Least, deadline) {
-                        Err(PhysicsError::Solver { .. }) if past(deadline) || stopped() => {
-                            complete = false;
-                            cancelled = stopped();
-                            break;
-                        }
-                        r => r?,
+                    let Some(done) = solve_late(
+                        s,
+                        &late,
+                        (params, deadline, cancel),
+                        &mut current,
+                        &mut exact,
+                        &mut reserve,
+                    )?
+                    else {
+                        complete = false;
+                        cancelled = stopped();
+                        break;
                     };
-                    solves += results.iter().filter(|r| r.1 == Found::Solved).count();
-                    for (job, (r, found, secs)) in late.iter().zip(results) {
-                        reserve.note(job.pieces.len(), found, secs);
-                        for (&p, st) in job.pieces.iter().zip(r) {
-                            current[p] = st;
-                            exact[p] = true;
-                        }
-                    }
+                    solves += done.solves;
+                    certified += done.certified;
                     step_seconds = begun.elapsed().as_secs_f64();
                 }
             }
@@ -1081,24 +1080,22 @@ fn check_steps_in(
         // the deadline (the fandisk at 96 studs: a group of thousands of
         // pieces at step 189 took its check 28 s past it), and the check
         // is then cut there.
-        let results = match run_refs(s, &late, params, First::Least, deadline) {
-            Err(PhysicsError::Solver { .. }) if past(deadline) || stopped() => {
-                complete = false;
-                cancelled = stopped();
-                break;
-            }
-            r => r?,
+        let Some(done) = solve_late(
+            s,
+            &late,
+            (params, deadline, cancel),
+            &mut current,
+            &mut exact,
+            &mut reserve,
+        )?
+        else {
+            complete = false;
+            cancelled = stopped();
+            break;
         };
-        solves += results.iter().filter(|r| r.1 == Found::Solved).count();
-        certified += results.iter().filter(|r| r.1 == Found::Certified).count();
-        for (job, (r, found, secs)) in late.iter().zip(results) {
-            reserve.note(job.pieces.len(), found, secs);
-            step_seconds = step_seconds.max(secs);
-            for (&p, st) in job.pieces.iter().zip(r) {
-                current[p] = st;
-                exact[p] = true;
-            }
-        }
+        solves += done.solves;
+        certified += done.certified;
+        step_seconds = step_seconds.max(done.seconds);
         steps.push(check(step, &current[..end]));
         begin = end;
         if first_failure.is_none() && !steps[steps.len() - 1].stands {
@@ -1191,6 +1188,51 @@ fn check_steps_in(
         finished: finished.map(|(whole, secs)| Analysis::new(whole, secs)),
         map: drawn,
     })
+}
+
+/// What [`solve_late`] ran: programs solved, answers found without one,
+/// and the seconds of the longest.
+struct Late {
+    solves: usize,
+    certified: usize,
+    seconds: f64,
+}
+
+/// The programs of the groups `late` of a step (no certificate holds
+/// them: expected to fail), whose answers name what fails: each piece's
+/// stress into `current`, exact. `None` when they were cut short by the
+/// deadline, or stopped with the other half of a split check (`cancel`).
+fn solve_late(
+    s: &Structure,
+    late: &[&Job],
+    (params, deadline, cancel): (
+        &Params,
+        Option<Instant>,
+        Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ),
+    current: &mut [PieceStress],
+    exact: &mut [bool],
+    reserve: &mut Reserve,
+) -> Result<Option<Late>, PhysicsError> {
+    let stopped = || cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed));
+    let results = match run_refs(s, late, params, First::Least, deadline) {
+        Err(PhysicsError::Solver { .. }) if past(deadline) || stopped() => return Ok(None),
+        r => r?,
+    };
+    let mut done = Late {
+        solves: results.iter().filter(|r| r.1 == Found::Solved).count(),
+        certified: results.iter().filter(|r| r.1 == Found::Certified).count(),
+        seconds: 0.0,
+    };
+    for (job, (r, found, secs)) in late.iter().zip(results) {
+        reserve.note(job.pieces.len(), found, secs);
+        done.seconds = done.seconds.max(secs);
+        for (&p, st) in job.pieces.iter().zip(r) {
+            current[p] = st;
+            exact[p] = true;
+        }
+    }
+    Ok(Some(done))
 }
 
 /// Certifies `job` (its pieces from `begin` on are new) by the kept
