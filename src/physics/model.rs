@@ -155,9 +155,11 @@ pub(super) struct Structure {
 
 /// How far the programs of a [`Structure`] went: iterations in all, and
 /// of the one being solved (shared with whoever waits for them); and
-/// whether a group's program within capacity has answered that it has no
-/// equilibrium (the structure fails, before the program of least usage
-/// says what fails in it).
+/// whether a group's program within capacity was proved to have no
+/// answer (the structure fails, before the program of least usage says
+/// what fails in it; a group whose least usage lies within a millionth
+/// under a stud's capacity may still be found standing by that program,
+/// so this steers only what may be given up, never a verdict).
 #[derive(Debug, Default)]
 pub struct Progress {
     pub total: std::sync::atomic::AtomicU32,
@@ -467,7 +469,7 @@ pub(super) fn solve_until(
             // is told at once (see [`Progress::fails`]).
             Ok(_) | Err(PhysicsError::Solver { .. }) => {
                 if let (Some(p), Err(PhysicsError::Solver { status, .. })) = (&s.progress, &r) {
-                    if status.ends_with("PrimalInfeasible") {
+                    if status == "PrimalInfeasible" {
                         p.fails.store(true, std::sync::atomic::Ordering::Relaxed);
                     }
                 }

@@ -233,7 +233,10 @@ pub fn settle(
     let mut before = Before {
         first_failure: unrepaired_failure,
         min_score: None,
-        final_stands: None,
+        // The order repair kept in the first attempt certified its last
+        // step, the finished model (the same pieces in another order).
+        final_stands: (first.order_fix.is_some() && first.check.first_failure.is_none())
+            .then_some(true),
     };
     // A first check that failed at the last step has checked the finished
     // model: it fails, and its analysis there is the check's last.
@@ -836,7 +839,7 @@ fn walked(
         .collect();
     steps.extend(w.steps.iter().cloned());
     // Numbered 1, 2, ... as the new order's steps are.
-    let numbered = steps.iter().zip(1..).all(|(c, k)| c.step == k)
+    let numbered = steps.iter().zip(1..).all(|(c, k)| c.step == k && c.stands)
         && r.assembly.pieces.last().map(|p| p.step.0) == Some(steps.len() as u32)
         && w.last.pieces.len() == r.assembly.pieces.len();
     numbered.then(|| StepsAnalysis {
