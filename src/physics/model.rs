@@ -459,22 +459,20 @@ pub(super) fn solve_until(
             hands: false,
             ..method
         };
-        let r = solve_by(s, pieces, contacts, params, Some(&held), bare);
-        match r {
+        match solve_by(s, pieces, contacts, params, Some(&held), bare) {
             Ok(held) if !held.stress.iter().any(PieceStress::fails) => Ok(Some(held)),
             // Stopped (its answer no longer wanted): so would the other.
             Err(e @ PhysicsError::Solver { .. }) if late() => Err(e),
             // No answer within capacity (or the solver's trouble): the
             // other program says. The solver's proof that there is none
             // is told at once (see [`Progress::fails`]).
-            Ok(_) | Err(PhysicsError::Solver { .. }) => {
-                if let (Some(p), Err(PhysicsError::Solver { status, .. })) = (&s.progress, &r) {
-                    if status == "PrimalInfeasible" {
-                        p.fails.store(true, std::sync::atomic::Ordering::Relaxed);
-                    }
+            Err(PhysicsError::Solver { status, .. }) if status == "PrimalInfeasible" => {
+                if let Some(p) = &s.progress {
+                    p.fails.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
                 Ok(None)
             }
+            Ok(_) | Err(PhysicsError::Solver { .. }) => Ok(None),
             Err(e) => Err(e),
         }
     };

@@ -459,6 +459,9 @@ struct Finisher<'a, 'scope> {
     /// check waits), and the pool has more than one worker. Else the
     /// analysis is not started when due: the check stops for it.
     overlaps: bool,
+    /// Whether the check makes room for it at all (not the first half of
+    /// a split check): else [`Finisher::cut`] is the deadline.
+    wanted: bool,
 }
 
 impl<'a, 'scope> Finisher<'a, 'scope> {
@@ -484,6 +487,7 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
             made: false,
             given,
             overlaps: rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1,
+            wanted: true,
         };
         if matches!(finish, Finish::Alongside) {
             f.start(false);
@@ -523,6 +527,9 @@ impl<'a, 'scope> Finisher<'a, 'scope> {
         start: Instant,
         start_when_due: bool,
     ) -> Result<Option<Instant>, PhysicsError> {
+        if !self.wanted {
+            return Ok(deadline);
+        }
         if let State::Running { answer, .. } = &self.state {
             match answer.try_recv() {
                 Ok(r) => self.state = State::Done(r?),
@@ -863,6 +870,9 @@ fn check_whole(ask: &Ask, finish: Finish) -> Result<StepsAnalysis, PhysicsError>
     s.stop = Some(ask.cancel.cloned().unwrap_or_default());
     rayon::in_place_scope(|scope| {
         let mut fin = Finisher::new(scope, &s, ask.params, ask.assembly.pieces.len(), finish);
+        // The first half of a split check has nothing of the finished
+        // model's to make room for.
+        fin.wanted = ask.before.is_none();
         check_steps_in(ask, &s, start, &mut fin)
     })
 }
@@ -888,8 +898,6 @@ fn check_steps_in(
         go,
     } = *ask;
     let n = assembly.pieces.len();
-    // The first half of a split check has nothing of the finished model's
-    // to make room for.
     let half = before.is_some();
     // Stopped by the other half (see [`Ask::cancel`]): nothing more made.
     let mut cancelled = false;
@@ -961,12 +969,7 @@ fn check_steps_in(
         }
         if k == k0 && k0 > 0 {
             window.skip_to(k + 1);
-            let cut = if half {
-                deadline
-            } else {
-                fin.cut(&reserve, deadline, start, true)?
-            };
-            if past(cut) {
+            if past(fin.cut(&reserve, deadline, start, true)?) {
                 complete = false;
                 break;
             }
@@ -1030,12 +1033,7 @@ fn check_steps_in(
         }
         // The finished model's analysis, if not made yet, starts by the
         // time it takes before the deadline, so that the two end near it.
-        let cut = if half {
-            deadline
-        } else {
-            fin.cut(&reserve, deadline, start, true)?
-        };
-        if past(cut) {
+        if past(fin.cut(&reserve, deadline, start, true)?) {
             complete = false;
             break;
         }
@@ -1101,12 +1099,7 @@ fn check_steps_in(
         // Not started once the last step's programs are solved or about
         // to be: it would solve them again.
         let due = k != last_k;
-        let cut = if half || late.is_empty() {
-            deadline
-        } else {
-            fin.cut(&reserve, deadline, start, due)?
-        };
-        if !late.is_empty() && past(cut) {
+        if !late.is_empty() && past(fin.cut(&reserve, deadline, start, due)?) {
             complete = false;
             break;
         }
