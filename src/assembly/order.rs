@@ -15,97 +15,303 @@
 //! courses above join them. Every piece still joins an earlier one or the
 //! ground by construction, but a piece hung under the course above can be
 //! shut in by the courses laid under it first: [`by_course_placeable`]
-//! mends that, and the caller verifies the result (placeability
-//! included) and keeps the original order if it still fails.
+//! then holds the same greedy order to the ways each piece went in at its
+//! turn in the trace, which keeps every order rule of the verifier.
 
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, VecDeque};
 
-use super::verify::connections;
+use super::verify::{connections, verify, Placing};
 use super::{Assembly, Placed};
-use crate::geom::Body;
+use crate::geom::{Body, Cell, CellBox};
 
-/// Mends [`by_course_placeable`] makes at most.
-const MENDS: usize = 24;
-
-/// Pieces shut in past the first order's that stop the mends.
-const MEND_SLACK: usize = 10;
-
-/// [`by_course`], mended where it shuts a piece in: a piece hung under
-/// the course above (joined only to pieces over it) goes in from below,
-/// after the piece it hangs from, but the course-by-course order lays the
-/// courses under it first. The pieces under such a piece (in the column
-/// of its footprint, down to the ground) then come right after it, top
-/// down, each going in from below, and after them the pieces that joined
-/// the build only through them. `None` if the order still fails the
-/// verifier's order rules after a few mends (the caller keeps the
-/// search's trace, which climbs a part to its top before the next: the
-/// bunny at 56 studs then built a tower leaning out from its feet, which
-/// broke at step 3).
+/// [`by_course`], where that order keeps the verifier's order rules; else
+/// the course-by-course order held to the ways the pieces went in at
+/// their turns in `assembly`'s own order (a verified one), which keeps
+/// every rule by construction (`held_order`): a piece hung under the
+/// course above goes in from below, after the piece it hangs from, and
+/// the courses laid under it first can shut it in; held to its way in,
+/// the pieces in that way come after it. `None` only if `assembly`'s own
+/// order breaks those rules (the caller keeps it as it is).
+///
+/// Mending the course order instead, by moving everything under a
+/// shut-in piece after it, cascaded (at 64 studs the cow's three pieces
+/// hung one under another became 22 shut in) and often gave up: the
+/// search's trace was kept, and at 60 studs the engine's trace broke at
+/// step 51 where the held order stands. Holding only the pieces found
+/// shut in, a round at a time, kept more of the course order but stood
+/// less often (the engine at 52 studs broke at step 60).
 pub fn by_course_placeable(assembly: &Assembly) -> Option<Assembly> {
-    use super::verify::{verify, Failure};
     let bodies = bodies(assembly);
     let joins = connections(&bodies);
-    let boxes: Vec<_> = bodies.iter().map(|b| b.bbox).collect();
-    let ground = boxes.iter().map(|b| b.min.z).min().unwrap_or(0);
-    let mut order = course_order(assembly, &bodies, &joins);
-    let mut most = None;
-    for _ in 0..MENDS {
-        let ordered = reordered(assembly, &order);
-        let report = verify(&ordered, None);
-        if report.is_ok() {
-            return Some(ordered);
-        }
-        // A mend may shut in a few pieces more for a while (the bunny at
-        // 56 studs: 1, then 9, then down to none in 14 mends); mends that
-        // shut in ever more (at 96 studs: 7 to over a hundred) stop.
-        let most = *most.get_or_insert(report.failures.len() + MEND_SLACK);
-        if report.failures.len() > most {
-            return None;
-        }
-        let t = report.failures.iter().find_map(|f| match *f {
-            Failure::NotPlaceable { piece, .. } => Some(piece),
-            _ => None,
-        })?;
-        let b = boxes[order[t]];
-        // The pieces before it under its footprint, top down.
-        let mut below: Vec<(i32, usize)> = order[..t]
-            .iter()
-            .filter_map(|&i| {
-                let c = boxes[i];
-                let overlaps = c.min.x < b.min.x + b.sx
-                    && b.min.x < c.min.x + c.sx
-                    && c.min.y < b.min.y + b.sy
-                    && b.min.y < c.min.y + c.sy;
-                (overlaps && c.min.z + c.sz <= b.min.z).then_some((-(c.min.z + c.sz), i))
-            })
-            .collect();
-        below.sort_unstable();
-        let mut gone = vec![false; assembly.pieces.len()];
-        for &(_, i) in &below {
-            gone[i] = true;
-        }
-        // The pieces after them that joined the build only through them.
-        let mut before = vec![false; assembly.pieces.len()];
-        let mut after = Vec::new();
-        for &i in &order[..t] {
-            if !gone[i]
-                && boxes[i].min.z > ground
-                && !joins[i].iter().any(|&k| before[k] && !gone[k])
-            {
-                gone[i] = true;
-                after.push(i);
-            }
-            before[i] = true;
-        }
-        let mut next: Vec<usize> = order[..t].iter().copied().filter(|&i| !gone[i]).collect();
-        next.push(order[t]);
-        next.extend(below.iter().map(|&(_, i)| i));
-        next.extend(after);
-        next.extend_from_slice(&order[t + 1..]);
-        order = next;
+    let plain = reordered(assembly, &course_order(assembly, &bodies, &joins));
+    if verify(&plain, None).is_ok() {
+        return Some(plain);
     }
-    None
+    let boxes: Vec<CellBox> = bodies.iter().map(|b| b.bbox).collect();
+    let held = reordered(assembly, &held_order(assembly, &boxes, &joins));
+    verify(&held, None).is_ok().then_some(held)
+}
+
+/// For each piece of `boxes` (in a verified order), the later pieces in
+/// the way it went in at its turn: cells it passed through to its place
+/// ([`route`](super::verify::route)'s, carried on out of the finished
+/// build's bounds, so that the way stays open whatever else is placed
+/// first), and the free cells that joined it to the air around the build
+/// ([`Air::opening`]: the verifier's rule against closed cavities).
+fn ways_in(boxes: &[CellBox]) -> Vec<Vec<usize>> {
+    let n = boxes.len();
+    let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let Some(far) = bounds(boxes) else {
+        return after;
+    };
+    // Which piece fills each cell of the finished build.
+    let (o, hi) = far;
+    let (nx, ny, nz) = (hi.x - o.x + 1, hi.y - o.y + 1, hi.z - o.z + 1);
+    let index = |x: i32, y: i32, z: i32| (((z - o.z) * ny + (y - o.y)) * nx + (x - o.x)) as usize;
+    let mut owner = vec![u32::MAX; (nx * ny * nz) as usize];
+    for (i, b) in boxes.iter().enumerate() {
+        for c in b.cells() {
+            owner[index(c.x, c.y, c.z)] = i as u32;
+        }
+    }
+    let mut seen = vec![usize::MAX; n];
+    let mut placing = Placing::new(boxes);
+    let mut air = Air::new(far);
+    for (i, b) in boxes.iter().enumerate() {
+        let mut ways = placing.route(b, far).unwrap_or_default();
+        ways.extend(air.opening(b, |c| placing.taken(c)));
+        for w in ways {
+            let xs = w.min.x.max(o.x)..(w.min.x + w.sx).min(hi.x + 1);
+            let ys = w.min.y.max(o.y)..(w.min.y + w.sy).min(hi.y + 1);
+            for z in w.min.z.max(o.z)..(w.min.z + w.sz).min(hi.z + 1) {
+                for y in ys.clone() {
+                    for x in xs.clone() {
+                        let j = owner[index(x, y, z)];
+                        if j != u32::MAX && j as usize > i && seen[j as usize] != i {
+                            seen[j as usize] = i;
+                            after[i].push(j as usize);
+                        }
+                    }
+                }
+            }
+        }
+        placing.add(b);
+    }
+    after
+}
+
+/// The course-by-course order of [`course_order`] in which each piece
+/// comes before the later pieces (in `assembly`'s own order) in its way
+/// in ([`ways_in`]). The assembly's own order keeps every such precedence
+/// and joins each piece to an earlier one, so the first piece of it not
+/// yet placed can always come next: the order never stalls.
+fn held_order(assembly: &Assembly, boxes: &[CellBox], joins: &[Vec<usize>]) -> Vec<usize> {
+    let n = boxes.len();
+    let ways = ways_in(boxes);
+    let mut waits = vec![0usize; n];
+    for &j in ways.iter().flatten() {
+        waits[j] += 1;
+    }
+    let layer_ldu = assembly.layer_ldu;
+    let course = |i: usize| (assembly.pieces[i].placement.origin.z * layer_ldu).div_euclid(24);
+    let ground = boxes.iter().map(|b| b.min.z).min().unwrap_or(0);
+    let mut placed = vec![false; n];
+    let mut queued = vec![false; n];
+    let mut heap: BinaryHeap<Reverse<(i32, usize)>> = BinaryHeap::new();
+    let mut order = Vec::with_capacity(n);
+    let mut first = 0;
+    for (i, b) in boxes.iter().enumerate() {
+        if b.min.z == ground && waits[i] == 0 {
+            queued[i] = true;
+            heap.push(Reverse((course(i), i)));
+        }
+    }
+    while order.len() < n {
+        let i = match heap.pop() {
+            Some(Reverse((_, i))) => i,
+            None => {
+                // Only for an order that was not verified: its first piece
+                // not yet placed.
+                while placed[first] {
+                    first += 1;
+                }
+                queued[first] = true;
+                first
+            }
+        };
+        placed[i] = true;
+        order.push(i);
+        let joined = |j: usize, placed: &[bool]| {
+            boxes[j].min.z == ground || joins[j].iter().any(|&k| placed[k])
+        };
+        for &j in &ways[i] {
+            waits[j] -= 1;
+            if waits[j] == 0 && !queued[j] && joined(j, &placed) {
+                queued[j] = true;
+                heap.push(Reverse((course(j), j)));
+            }
+        }
+        for &j in &joins[i] {
+            if waits[j] == 0 && !queued[j] {
+                queued[j] = true;
+                heap.push(Reverse((course(j), j)));
+            }
+        }
+    }
+    order
+}
+
+/// The free cells around a piece, searched for a way from its box to the
+/// space around the build (beside the finished build's bounds or over
+/// them, never under the table): the verifier's rule that no piece is
+/// built inside a closed cavity.
+struct Air {
+    /// The inclusive corners of the search: the build's bounds grown by a
+    /// cell at the sides and over the top.
+    lo: Cell,
+    hi: Cell,
+    /// The search that last reached each cell, and the cell it came from.
+    mark: Vec<u32>,
+    from: Vec<u32>,
+    search: u32,
+}
+
+impl Air {
+    fn new((lo, hi): (Cell, Cell)) -> Air {
+        let (lo, hi) = (lo.offset(-1, -1, 0), hi.offset(1, 1, 1));
+        let n = ((hi.x - lo.x + 1) * (hi.y - lo.y + 1) * (hi.z - lo.z + 1)) as usize;
+        Air {
+            lo,
+            hi,
+            mark: vec![0; n],
+            from: vec![0; n],
+            search: 0,
+        }
+    }
+
+    fn index(&self, c: Cell) -> Option<usize> {
+        let (lo, hi) = (self.lo, self.hi);
+        let inside = (lo.x..=hi.x).contains(&c.x)
+            && (lo.y..=hi.y).contains(&c.y)
+            && (lo.z..=hi.z).contains(&c.z);
+        inside.then(|| {
+            let (nx, ny) = (hi.x - lo.x + 1, hi.y - lo.y + 1);
+            (((c.z - lo.z) * ny + (c.y - lo.y)) * nx + (c.x - lo.x)) as usize
+        })
+    }
+
+    fn cell(&self, i: usize) -> Cell {
+        let (nx, ny) = (self.hi.x - self.lo.x + 1, self.hi.y - self.lo.y + 1);
+        let i = i as i32;
+        self.lo.offset(i % nx, (i / nx) % ny, i / (nx * ny))
+    }
+
+    /// Whether `c` is on the search's border: the space around the build.
+    fn border(&self, c: Cell) -> bool {
+        c.x == self.lo.x
+            || c.y == self.lo.y
+            || c.x == self.hi.x
+            || c.y == self.hi.y
+            || c.z == self.hi.z
+    }
+
+    /// Cells free now (`taken` says which are not) that join the box `b`
+    /// face to face to the space around the build: the box's column
+    /// straight up or a straight run of its slab sideways where one is
+    /// free, else the shortest path a breadth-first search finds. Empty
+    /// if there is none.
+    fn opening(&mut self, b: &CellBox, taken: impl Fn(&CellBox) -> bool) -> Vec<CellBox> {
+        let (lo, hi) = (self.lo, self.hi);
+        let m = b.max_excl();
+        let straight = [
+            CellBox {
+                min: Cell::new(b.min.x, b.min.y, m.z),
+                sz: hi.z + 1 - m.z,
+                ..*b
+            },
+            CellBox {
+                min: Cell::new(m.x, b.min.y, b.min.z),
+                sx: hi.x + 1 - m.x,
+                ..*b
+            },
+            CellBox {
+                min: Cell::new(lo.x, b.min.y, b.min.z),
+                sx: b.min.x - lo.x,
+                ..*b
+            },
+            CellBox {
+                min: Cell::new(b.min.x, m.y, b.min.z),
+                sy: hi.y + 1 - m.y,
+                ..*b
+            },
+            CellBox {
+                min: Cell::new(b.min.x, lo.y, b.min.z),
+                sy: b.min.y - lo.y,
+                ..*b
+            },
+        ];
+        if let Some(w) = straight.into_iter().find(|w| w.volume() > 0 && !taken(w)) {
+            return vec![w];
+        }
+        self.search += 1;
+        let search = self.search;
+        let mut queue = VecDeque::new();
+        for c in b.cells() {
+            if let Some(i) = self.index(c) {
+                self.mark[i] = search;
+                self.from[i] = u32::MAX;
+                queue.push_back(i);
+            }
+        }
+        while let Some(i) = queue.pop_front() {
+            let c = self.cell(i);
+            if self.border(c) {
+                let mut path = Vec::new();
+                let mut k = i;
+                while self.from[k] != u32::MAX {
+                    path.push(unit(self.cell(k)));
+                    k = self.from[k] as usize;
+                }
+                return path;
+            }
+            for (dx, dy, dz) in crate::geom::FACES {
+                let n = c.offset(dx, dy, dz);
+                let Some(j) = self.index(n) else { continue };
+                if self.mark[j] != search && !taken(&unit(n)) {
+                    self.mark[j] = search;
+                    self.from[j] = i as u32;
+                    queue.push_back(j);
+                }
+            }
+        }
+        Vec::new()
+    }
+}
+
+/// The box of the one cell `c`.
+fn unit(c: Cell) -> CellBox {
+    CellBox {
+        min: c,
+        sx: 1,
+        sy: 1,
+        sz: 1,
+    }
+}
+
+/// The inclusive corners of the boxes, `None` if there are none.
+fn bounds(boxes: &[CellBox]) -> Option<(Cell, Cell)> {
+    let first = boxes.first()?;
+    Some(boxes.iter().fold(
+        (first.min, first.max_excl().offset(-1, -1, -1)),
+        |(lo, hi), b| {
+            let m = b.max_excl().offset(-1, -1, -1);
+            (
+                Cell::new(lo.x.min(b.min.x), lo.y.min(b.min.y), lo.z.min(b.min.z)),
+                Cell::new(hi.x.max(m.x), hi.y.max(m.y), hi.z.max(m.z)),
+            )
+        },
+    ))
 }
 
 /// `assembly`'s pieces in `order` (indices into its pieces), one a step.
@@ -190,7 +396,6 @@ fn course_order(assembly: &Assembly, bodies: &[Body], joins: &[Vec<usize>]) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::verify::verify;
     use crate::assembly::Placement;
     use crate::catalog::{Color, PartKind};
     use crate::geom::{Cell, Rot};

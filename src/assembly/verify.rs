@@ -627,6 +627,22 @@ impl Placing {
     pub(crate) fn placeable(&self, b: &CellBox) -> bool {
         placeable(b, &self.0)
     }
+
+    /// Whether a cell of box `b` is taken.
+    pub(crate) fn taken(&self, b: &CellBox) -> bool {
+        self.0.any_in(b)
+    }
+
+    /// The way the piece in box `b` goes in now, as [`route`] gives it
+    /// (`far`: the inclusive corners of every piece that may come), or
+    /// `None` if it cannot.
+    pub(crate) fn route(&self, b: &CellBox, far: (Cell, Cell)) -> Option<Vec<CellBox>> {
+        match self.0.bounds {
+            Some((lo, hi)) => route(b, lo, hi, |x| self.0.any_in(x), far),
+            // The first piece: from above, onto the table.
+            None => route(b, b.min, b.max_excl().offset(-1, -1, -1), |_| false, far),
+        }
+    }
 }
 
 /// The placeability rule of the module docs.
@@ -664,6 +680,100 @@ pub(crate) fn escape(
     taken: impl Fn(&CellBox) -> bool,
     limit: usize,
 ) -> Escape {
+    match search_out(b, lo, hi, taken, limit, None) {
+        Ok(_) => Escape::Out,
+        Err((plo, phi)) => Escape::Stuck(plo, phi),
+    }
+}
+
+/// How [`search_out`] found the piece leaving the bounding box, from the
+/// last position of its way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Exit {
+    /// The position is outside the bounding box already.
+    Beyond,
+    /// A straight move up, its column clear.
+    Up,
+    /// A straight press from below, its column clear.
+    Down,
+    /// A straight slide along `(dx, dy)`, its studs clear.
+    Side(i32, i32),
+}
+
+/// The cells a piece in box `b` passes through on its way out of the
+/// bounding box `lo..=hi` of the occupied cells (`taken` as for
+/// [`escape`]), with one layer over and under each position (its studs'
+/// clearance), and its last move carried on out of the bounding box
+/// `far_lo..=far_hi` of every piece that may come (the finished build):
+/// boxes that, free of other pieces, let it in by the same way however
+/// many pieces are placed elsewhere. `None` if it cannot get out.
+pub(crate) fn route(
+    b: &CellBox,
+    lo: Cell,
+    hi: Cell,
+    taken: impl Fn(&CellBox) -> bool,
+    (far_lo, far_hi): (Cell, Cell),
+) -> Option<Vec<CellBox>> {
+    let mut parents = HashMap::new();
+    let (at, exit) = search_out(b, lo, hi, taken, usize::MAX, Some(&mut parents)).ok()?;
+    let grown = |p: Cell| CellBox {
+        min: p.offset(0, 0, -1),
+        sz: b.sz + 2,
+        ..*b
+    };
+    let mut sweep = vec![grown(at)];
+    let mut p = at;
+    while let Some(&q) = parents.get(&p) {
+        sweep.push(grown(q));
+        p = q;
+    }
+    // The last move's direction, carried on past the far side.
+    let (dx, dy, dz) = match exit {
+        Exit::Up => (0, 0, 1),
+        Exit::Down => (0, 0, -1),
+        Exit::Side(dx, dy) => (dx, dy, 0),
+        Exit::Beyond if at.z > hi.z => (0, 0, 1),
+        Exit::Beyond if at.z + b.sz <= lo.z => (0, 0, -1),
+        Exit::Beyond if at.x > hi.x => (1, 0, 0),
+        Exit::Beyond if at.x + b.sx <= lo.x => (-1, 0, 0),
+        Exit::Beyond if at.y > hi.y => (0, 1, 0),
+        Exit::Beyond => (0, -1, 0),
+    };
+    // The cells of the positions from `a` on past the far side `flo..=fhi`
+    // along one axis, for a piece `n` cells long there: `(start, length)`.
+    let span = |a: i32, n: i32, d: i32, flo: i32, fhi: i32| match d {
+        1 => (a, (fhi + 1 - a).max(0) + n),
+        -1 => (a.min(flo - n), n + (a - (flo - n)).max(0)),
+        _ => (a, n),
+    };
+    let (x0, sx) = span(at.x, b.sx, dx, far_lo.x, far_hi.x);
+    let (y0, sy) = span(at.y, b.sy, dy, far_lo.y, far_hi.y);
+    // A slide keeps its studs clear, a vertical move needs no more.
+    let (z0, sz) = match dz {
+        0 => (at.z - 1, b.sz + 2),
+        _ => span(at.z, b.sz, dz, far_lo.z, far_hi.z),
+    };
+    sweep.push(CellBox {
+        min: Cell::new(x0, y0, z0),
+        sx,
+        sy,
+        sz,
+    });
+    Some(sweep)
+}
+
+/// [`escape`]'s search: the last position of the way out and how it
+/// leaves, or the inclusive corners of the positions reached. With
+/// `parents`, each position the search reached is recorded with the one
+/// it came from.
+fn search_out(
+    b: &CellBox,
+    lo: Cell,
+    hi: Cell,
+    taken: impl Fn(&CellBox) -> bool,
+    limit: usize,
+    mut parents: Option<&mut HashMap<Cell, Cell>>,
+) -> Result<(Cell, Exit), (Cell, Cell)> {
     let outside = |p: Cell| {
         p.x + b.sx <= lo.x
             || p.x > hi.x
@@ -695,14 +805,14 @@ pub(crate) fn escape(
         !taken(&column(p, p.z + b.sz, p.z + b.sz + 1)) && !taken(&column(p, p.z - 1, p.z))
     };
     if !free(b.min) {
-        return Escape::Stuck(b.min, b.min);
+        return Err((b.min, b.min));
     }
     let mut seen = crate::geom::CellSet::from_iter([b.min]);
     let mut queue = VecDeque::from([b.min]);
     let (mut plo, mut phi) = (b.min, b.min);
     while let Some(p) = queue.pop_front() {
         if outside(p) {
-            return Escape::Out;
+            return Ok((p, Exit::Beyond));
         }
         if seen.len() > limit {
             break;
@@ -710,8 +820,11 @@ pub(crate) fn escape(
         plo = Cell::new(plo.x.min(p.x), plo.y.min(p.y), plo.z.min(p.z));
         phi = Cell::new(phi.x.max(p.x), phi.y.max(p.y), phi.z.max(p.z));
         // A straight drop from above or press from below.
-        if !taken(&column(p, p.z + b.sz, hi.z + 1)) || !taken(&column(p, lo.z, p.z)) {
-            return Escape::Out;
+        if !taken(&column(p, p.z + b.sz, hi.z + 1)) {
+            return Ok((p, Exit::Up));
+        }
+        if !taken(&column(p, lo.z, p.z)) {
+            return Ok((p, Exit::Down));
         }
         let clear_here = clear(p);
         // Straight sideways out, studs clear all the way.
@@ -720,7 +833,7 @@ pub(crate) fn escape(
                 let mut q = p;
                 loop {
                     if outside(q) {
-                        return Escape::Out;
+                        return Ok((p, Exit::Side(dx, dy)));
                     }
                     q = q.offset(dx, dy, 0);
                     if !free(q) || !clear(q) {
@@ -746,10 +859,13 @@ pub(crate) fn escape(
                 continue;
             }
             seen.insert(q);
+            if let Some(parents) = parents.as_deref_mut() {
+                parents.insert(q, p);
+            }
             queue.push_back(q);
         }
     }
-    Escape::Stuck(plo, phi)
+    Err((plo, phi))
 }
 
 #[cfg(test)]

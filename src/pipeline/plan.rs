@@ -284,8 +284,8 @@ impl<'a> Planner<'a> {
                 report: check.to_string(),
             });
         }
-        // Course by course (mended where that shuts a hung piece in), else
-        // the trace as it is.
+        // Course by course (held to the trace's ways in where that shuts a
+        // hung piece in), else the trace as it is.
         let (mut assembly, name) = match by_course_placeable(&assembly) {
             Some(ordered) if verify(&ordered, Some(&outcome.voxels)).is_ok() => {
                 (ordered, "by course")
