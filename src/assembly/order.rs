@@ -400,6 +400,64 @@ mod tests {
     use crate::catalog::{Color, PartKind};
     use crate::geom::{Cell, Rot};
 
+    /// A 2 x 2 brick on the table in a walled pen under a lid, beside a
+    /// free 2 x 2 of the pen whose wall has a gap: no straight run of free
+    /// cells leaves the brick, and the way the air reaches it bends
+    /// through the free part and out of the gap.
+    #[test]
+    fn the_air_reaches_a_brick_in_a_pen_through_its_gap() {
+        let cell = |x, y, z, sx, sy| CellBox {
+            min: Cell::new(x, y, z),
+            sx,
+            sy,
+            sz: 1,
+        };
+        let mut taken = vec![cell(0, 0, 1, 8, 6)];
+        for (x, y) in [
+            (0, 0),
+            (2, 0),
+            (4, 0),
+            (6, 0),
+            (0, 2),
+            (6, 2),
+            (0, 4),
+            (2, 4),
+            (6, 4),
+        ] {
+            taken.push(cell(x, y, 0, 2, 2));
+        }
+        let far = (Cell::new(0, 0, 0), Cell::new(7, 5, 1));
+        let brick = cell(2, 2, 0, 2, 2);
+        let meets = |taken: &[CellBox], b: &CellBox| {
+            taken.iter().any(|t| {
+                t.min.x < b.min.x + b.sx
+                    && b.min.x < t.min.x + t.sx
+                    && t.min.y < b.min.y + b.sy
+                    && b.min.y < t.min.y + t.sy
+                    && t.min.z < b.min.z + b.sz
+                    && b.min.z < t.min.z + t.sz
+            })
+        };
+        let way = Air::new(far).opening(&brick, |b| meets(&taken, b));
+        assert!(way.iter().all(|c| c.volume() == 1 && !meets(&taken, c)));
+        // Out through the gap, the free part of the pen on the way.
+        let cells: Vec<Cell> = way.iter().map(|c| c.min).collect();
+        assert!(cells
+            .iter()
+            .any(|c| c.x >= 4 && c.y >= 4 && c.x < 6 && c.y < 6));
+        assert!(cells
+            .iter()
+            .any(|c| c.x >= 4 && c.x < 6 && (2..4).contains(&c.y)));
+        assert!(cells
+            .iter()
+            .any(|c| c.y == 6 || c.y == -1 || c.x == -1 || c.x == 8));
+        // The gap closed, the pen has no way out but under the table.
+        taken.push(cell(4, 4, 0, 2, 2));
+        assert!(Air::new(far)
+            .opening(&brick, |b| meets(&taken, b))
+            .is_empty());
+    }
+
     #[test]
     fn a_zigzag_trace_is_built_course_by_course() {
         let brick = PartKind::from_id("3001").unwrap();

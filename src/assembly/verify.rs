@@ -935,6 +935,91 @@ mod tests {
         build(&pieces)
     }
 
+    /// The way in of a brick hung under a beam is the column under it, on
+    /// down past the build's lowest layer; a brick on top drops in from
+    /// over the build's highest; a brick on the table between walls slides
+    /// out of the end left open, its studs clear.
+    #[test]
+    fn a_route_goes_on_past_the_bounds_of_what_may_come() {
+        let asm = build(&[
+            ("3003", 0, 0, 0, R0),
+            ("3003", 0, 0, 1, R0),
+            ("3001", 0, 0, 2, R0),
+        ]);
+        let boxes: Vec<CellBox> = asm
+            .pieces
+            .iter()
+            .map(|p| p.placement.body(asm.layer_ldu).bbox)
+            .collect();
+        let mut placing = Placing::new(&boxes);
+        for b in &boxes {
+            placing.add(b);
+        }
+        let far = (Cell::new(-5, -5, 0), Cell::new(9, 9, 6));
+        let hung = CellBox {
+            min: Cell::new(2, 0, 1),
+            sx: 2,
+            sy: 2,
+            sz: 1,
+        };
+        let way = placing.route(&hung, far).expect("pressed up from below");
+        assert_eq!(
+            way.last(),
+            Some(&CellBox {
+                min: Cell::new(2, 0, -1),
+                sz: 3,
+                ..hung
+            })
+        );
+        let top = CellBox {
+            min: Cell::new(0, 0, 3),
+            ..hung
+        };
+        let way = placing.route(&top, far).expect("dropped from above");
+        assert_eq!(
+            way.last(),
+            Some(&CellBox {
+                min: Cell::new(0, 0, 3),
+                sz: 5,
+                ..hung
+            })
+        );
+        // A 2 x 2 between two walls three courses high on a floor, a course
+        // clear of the floor and of a brick over it: it slides out along
+        // y, the layers over it and under it clear.
+        let walls = build(&[
+            ("2456", 0, 0, 0, R0),
+            ("2456", 0, 2, 0, R0),
+            ("3001", 0, 0, 1, R90),
+            ("3001", 0, 0, 2, R90),
+            ("3001", 0, 0, 3, R90),
+            ("3001", 4, 0, 1, R90),
+            ("3001", 4, 0, 2, R90),
+            ("3001", 4, 0, 3, R90),
+            ("3003", 2, 0, 4, R0),
+        ]);
+        let boxes: Vec<CellBox> = walls
+            .pieces
+            .iter()
+            .map(|p| p.placement.body(walls.layer_ldu).bbox)
+            .collect();
+        let mut placing = Placing::new(&boxes);
+        for b in &boxes {
+            placing.add(b);
+        }
+        let inside = CellBox {
+            min: Cell::new(2, 0, 2),
+            ..hung
+        };
+        let way = placing.route(&inside, far).expect("slid out");
+        let last = *way.last().unwrap();
+        assert_eq!((last.min.x, last.sx, last.min.z, last.sz), (2, 2, 1, 3));
+        assert!(
+            last.min.y + last.sy > far.1.y + 2 || last.min.y < far.0.y - 1,
+            "{last:?}"
+        );
+    }
+
     #[test]
     fn a_piece_inside_a_closed_cavity_is_refused() {
         // The lid first: the piece in the hole is shut in (the table under
