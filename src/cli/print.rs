@@ -124,9 +124,18 @@ fn print_build_stability(st: &StabilityReport) {
         ),
         (Some(step), _, _) => format!("does not stand from step {step} on"),
     };
+    // Too big for the finished model's program in the budget: its scores
+    // are those of an equilibrium that certified it, one of many, which
+    // may use a joint to its capacity where the least-usage one does not.
+    let whose = match st.stress_map {
+        brickwright::physics::StressMap::Checked => "steps checked",
+        brickwright::physics::StressMap::Certificates => {
+            "finished model (an equilibrium found, not the least-usage one)"
+        }
+        brickwright::physics::StressMap::Program => "finished model",
+    };
     outln!(
-        "  stability: {verdict}; {}: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} {})",
-        if unknown { "steps checked" } else { "finished model" },
+        "  stability: {verdict}; {whose}: lowest score {:.2}, mean {:.2} (score = 1 - share of stud clutch used; {} {})",
         st.min_score,
         st.mean_score,
         st.solves,
