@@ -428,16 +428,7 @@ mod tests {
         }
         let far = (Cell::new(0, 0, 0), Cell::new(7, 5, 1));
         let brick = cell(2, 2, 0, 2, 2);
-        let meets = |taken: &[CellBox], b: &CellBox| {
-            taken.iter().any(|t| {
-                t.min.x < b.min.x + b.sx
-                    && b.min.x < t.min.x + t.sx
-                    && t.min.y < b.min.y + b.sy
-                    && b.min.y < t.min.y + t.sy
-                    && t.min.z < b.min.z + b.sz
-                    && b.min.z < t.min.z + t.sz
-            })
-        };
+        let meets = |taken: &[CellBox], b: &CellBox| taken.iter().any(|t| t.intersects(b));
         let way = Air::new(far).opening(&brick, |b| meets(&taken, b));
         assert!(way.iter().all(|c| c.volume() == 1 && !meets(&taken, c)));
         // Out through the gap, the free part of the pen on the way.

@@ -941,20 +941,24 @@ mod tests {
     /// out of the end left open, its studs clear.
     #[test]
     fn a_route_goes_on_past_the_bounds_of_what_may_come() {
-        let asm = build(&[
+        // Every piece of `asm` put in place.
+        let placed = |asm: &Assembly| {
+            let boxes: Vec<CellBox> = asm
+                .pieces
+                .iter()
+                .map(|p| p.placement.body(asm.layer_ldu).bbox)
+                .collect();
+            let mut placing = Placing::new(&boxes);
+            for b in &boxes {
+                placing.add(b);
+            }
+            placing
+        };
+        let placing = placed(&build(&[
             ("3003", 0, 0, 0, R0),
             ("3003", 0, 0, 1, R0),
             ("3001", 0, 0, 2, R0),
-        ]);
-        let boxes: Vec<CellBox> = asm
-            .pieces
-            .iter()
-            .map(|p| p.placement.body(asm.layer_ldu).bbox)
-            .collect();
-        let mut placing = Placing::new(&boxes);
-        for b in &boxes {
-            placing.add(b);
-        }
+        ]));
         let far = (Cell::new(-5, -5, 0), Cell::new(9, 9, 6));
         let hung = CellBox {
             min: Cell::new(2, 0, 1),
@@ -987,7 +991,7 @@ mod tests {
         // A 2 x 2 between two walls three courses high on a floor, a course
         // clear of the floor and of a brick over it: it slides out along
         // y, the layers over it and under it clear.
-        let walls = build(&[
+        let placing = placed(&build(&[
             ("2456", 0, 0, 0, R0),
             ("2456", 0, 2, 0, R0),
             ("3001", 0, 0, 1, R90),
@@ -997,16 +1001,7 @@ mod tests {
             ("3001", 4, 0, 2, R90),
             ("3001", 4, 0, 3, R90),
             ("3003", 2, 0, 4, R0),
-        ]);
-        let boxes: Vec<CellBox> = walls
-            .pieces
-            .iter()
-            .map(|p| p.placement.body(walls.layer_ldu).bbox)
-            .collect();
-        let mut placing = Placing::new(&boxes);
-        for b in &boxes {
-            placing.add(b);
-        }
+        ]));
         let inside = CellBox {
             min: Cell::new(2, 0, 2),
             ..hung
