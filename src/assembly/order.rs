@@ -104,8 +104,11 @@ fn ways_in(boxes: &[CellBox]) -> Vec<Vec<usize>> {
 /// The course-by-course order of [`course_order`] in which each piece
 /// comes before the later pieces (in `assembly`'s own order) in its way
 /// in ([`ways_in`]). The assembly's own order keeps every such precedence
-/// and joins each piece to an earlier one, so the first piece of it not
-/// yet placed can always come next: the order never stalls.
+/// and joins each piece but its first to an earlier one or the ground;
+/// its first piece, if off the ground, comes first here too (the
+/// verifier asks no join of it, and none of the first piece placed). So
+/// the first piece of it not yet placed can always come next: the order
+/// never stalls.
 fn held_order(assembly: &Assembly, boxes: &[CellBox], joins: &[Vec<usize>]) -> Vec<usize> {
     let n = boxes.len();
     let ways = ways_in(boxes);
@@ -127,9 +130,15 @@ fn held_order(assembly: &Assembly, boxes: &[CellBox], joins: &[Vec<usize>]) -> V
             heap.push(Reverse((course(i), i)));
         }
     }
+    // The first piece, if off the ground, before all else (it waits for
+    // no piece: none comes before it).
+    let mut next = (n > 0 && boxes[0].min.z != ground).then_some(0);
+    if next.is_some() {
+        queued[0] = true;
+    }
     while order.len() < n {
-        let i = match heap.pop() {
-            Some(Reverse((_, i))) => i,
+        let i = match next.take().or_else(|| heap.pop().map(|Reverse((_, i))| i)) {
+            Some(i) => i,
             None => {
                 // Only for an order that was not verified: its first piece
                 // not yet placed.
