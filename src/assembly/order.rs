@@ -310,17 +310,8 @@ fn unit(c: Cell) -> CellBox {
 
 /// The inclusive corners of the boxes, `None` if there are none.
 fn bounds(boxes: &[CellBox]) -> Option<(Cell, Cell)> {
-    let first = boxes.first()?;
-    Some(boxes.iter().fold(
-        (first.min, first.max_excl().offset(-1, -1, -1)),
-        |(lo, hi), b| {
-            let m = b.max_excl().offset(-1, -1, -1);
-            (
-                Cell::new(lo.x.min(b.min.x), lo.y.min(b.min.y), lo.z.min(b.min.z)),
-                Cell::new(hi.x.max(m.x), hi.y.max(m.y), hi.z.max(m.z)),
-            )
-        },
-    ))
+    let all = boxes.iter().copied().reduce(|a, b| a.union(&b))?;
+    Some((all.min, all.max_excl().offset(-1, -1, -1)))
 }
 
 /// `assembly`'s pieces in `order` (indices into its pieces), one a step.
