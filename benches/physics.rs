@@ -29,7 +29,7 @@ use std::path::Path;
 
 use brickwright::assembly::Assembly;
 use brickwright::catalog::Color;
-use brickwright::physics::support::shore_up;
+use brickwright::physics::support::{shore_up, Upto};
 use brickwright::physics::{analyze, analyze_steps, Params};
 
 mod common;
@@ -78,9 +78,17 @@ fn bench(c: &mut Criterion) {
         .first_failure;
     group.bench_function(BenchmarkId::new("support/arch", arch.pieces.len()), |b| {
         b.iter(|| {
-            let shored = shore_up(&arch, &params, fails, 0, Color(71), None, false)
-                .expect("solves")
-                .expect("columns");
+            let shored = shore_up(
+                &arch,
+                &params,
+                fails.map_or(Upto::Finished, Upto::Failing),
+                0,
+                Color(71),
+                None,
+                false,
+            )
+            .expect("solves")
+            .expect("columns");
             assert!(shored.stands);
             shored
         })

@@ -161,8 +161,22 @@ pub struct Shored {
     pub solves: usize,
 }
 
+/// What [`shore_up`] holds up: the structure built by the end of a step,
+/// or the finished model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Upto {
+    /// The finished model.
+    Finished,
+    /// The structure built by the end of this step.
+    Step(u32),
+    /// The structure built by the end of this step, which the caller's
+    /// check found failing: the first round plans its columns at once,
+    /// without a program of its own to say so again.
+    Failing(u32),
+}
+
 /// Adds support columns until the structure built by the end of step
-/// `upto` (the finished model when `None`) stands, or [`MAX_COLUMNS`]
+/// `upto` stands, or [`MAX_COLUMNS`]
 /// (counting `already`) are in, or the deadline passes (a round that
 /// would end past it, taking as long as the round before, does not
 /// start, and a round's programs stop at it: the columns of the rounds
@@ -173,14 +187,20 @@ pub struct Shored {
 pub fn shore_up(
     assembly: &Assembly,
     params: &Params,
-    upto: Option<u32>,
+    upto: Upto,
     already: usize,
     color: Color,
     deadline: Option<std::time::Instant>,
     moves: bool,
 ) -> Result<Option<Shored>, PhysicsError> {
     let mut asm = assembly.clone();
-    let mut upto = upto;
+    // Whether the structure is known to fail (only before the first
+    // round's columns), and the last step it holds.
+    let (mut known_to_fail, mut upto) = match upto {
+        Upto::Finished => (false, None),
+        Upto::Step(s) => (false, Some(s)),
+        Upto::Failing(s) => (true, Some(s)),
+    };
     let mut columns: Vec<Column> = Vec::new();
     let mut pieces: Vec<Placement> = Vec::new();
     let mut solves = 0;
@@ -203,17 +223,20 @@ pub fn shore_up(
             pieces: asm.pieces[..end].to_vec(),
             layer_ldu: asm.layer_ldu,
         };
-        solves += 1;
         // Its programs, and the plan's, stop at the deadline: a round past
-        // it ends the rounds with the columns found so far.
-        match analyze_by(&prefix, params, First::Within, deadline) {
-            Ok(a) if a.stands() => {
-                stands = true;
-                break;
+        // it ends the rounds with the columns found so far. The verdict
+        // alone: what fails is the plan's program's to find.
+        if !std::mem::take(&mut known_to_fail) {
+            solves += 1;
+            match analyze_by(&prefix, params, First::Verdict, deadline) {
+                Ok(a) if a.stands() => {
+                    stands = true;
+                    break;
+                }
+                Ok(_) => {}
+                Err(PhysicsError::Solver { .. }) if past(deadline) => break,
+                Err(e) => return Err(e),
             }
-            Ok(_) => {}
-            Err(PhysicsError::Solver { .. }) if past(deadline) => break,
-            Err(e) => return Err(e),
         }
         let room = MAX_COLUMNS.saturating_sub(already + columns.len());
         if room == 0 || round == ROUNDS {
@@ -859,7 +882,7 @@ mod tests {
         let params = Params::default();
         let asm = gallows();
         assert!(!analyze(&asm, &params).unwrap().stands());
-        let shored = shore_up(&asm, &params, None, 0, Color(71), None, false)
+        let shored = shore_up(&asm, &params, Upto::Finished, 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
@@ -907,7 +930,7 @@ mod tests {
             assert!(p.placement.body(24).cells().all(|c| !model.contains(&c)));
         }
         // The same input gives the same columns.
-        let again = shore_up(&asm, &params, None, 0, Color(71), None, false)
+        let again = shore_up(&asm, &params, Upto::Finished, 0, Color(71), None, false)
             .unwrap()
             .unwrap();
         assert_eq!(again.assembly, shored.assembly);
@@ -927,7 +950,7 @@ mod tests {
             layer_ldu: 24,
         };
         assert!(!analyze(&asm, &params).unwrap().stands());
-        let shored = shore_up(&asm, &params, None, 0, Color(71), None, false)
+        let shored = shore_up(&asm, &params, Upto::Finished, 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
@@ -964,21 +987,29 @@ mod tests {
     fn a_step_is_shored_up_with_columns_before_it_and_a_standing_build_is_left_alone() {
         let params = Params::default();
         let asm = gallows();
-        let shored = shore_up(&asm, &params, Some(4), 0, Color(71), None, false)
+        let shored = shore_up(&asm, &params, Upto::Step(4), 0, Color(71), None, false)
             .unwrap()
             .expect("a column");
         assert!(shored.stands);
         assert_eq!(shored.columns.len(), 1);
         // Up to step 3 the post stands: nothing to do.
-        assert!(shore_up(&asm, &params, Some(3), 0, Color(71), None, false)
-            .unwrap()
-            .is_none());
-        // No room left for columns: nothing added.
         assert!(
-            shore_up(&asm, &params, None, MAX_COLUMNS, Color(71), None, false)
+            shore_up(&asm, &params, Upto::Step(3), 0, Color(71), None, false)
                 .unwrap()
                 .is_none()
         );
+        // No room left for columns: nothing added.
+        assert!(shore_up(
+            &asm,
+            &params,
+            Upto::Finished,
+            MAX_COLUMNS,
+            Color(71),
+            None,
+            false
+        )
+        .unwrap()
+        .is_none());
     }
 
     #[test]

@@ -30,7 +30,7 @@ use crate::assembly::verify::verify;
 use crate::assembly::{Assembly, Placement};
 use crate::catalog::Color;
 use crate::physics::repair::{reorder_while, Moved, MAX_REPAIRED_STEP};
-use crate::physics::support::{shore_up, steps_of, support_color, Column, MAX_COLUMNS};
+use crate::physics::support::{shore_up, steps_of, support_color, Column, Upto, MAX_COLUMNS};
 use crate::physics::{
     analyze, analyze_if_stands, analyze_steps_verdicts, Analysis, Finish, Ground, Params, Pending,
     PhysicsError, StepsAnalysis, StressMap, GRACE,
@@ -1070,7 +1070,7 @@ fn support(
         let Some(shored) = shore_up(
             asm,
             params,
-            Some(target),
+            Upto::Failing(target),
             kept.columns.len(),
             color,
             Some(deadline),
