@@ -733,6 +733,12 @@ impl<'a> Certifier<'a> {
         false
     }
 
+    /// Whether piece `p` moves in the proof kept that its group has no
+    /// equilibrium (see [`Certifier::still_fails`]).
+    pub(super) fn moves(&self, p: usize) -> bool {
+        self.proof[p] != [0.0; 3]
+    }
+
     /// Gives new piece `p` the motion its joints resist least: still, or
     /// moving with a piece it touches that moves.
     fn follow(&mut self, p: usize, bound: f64, vars: &mut Vec<Var>) {
