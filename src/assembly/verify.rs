@@ -808,6 +808,12 @@ fn search_out(
         return Err((b.min, b.min));
     }
     let mut seen = crate::geom::CellSet::from_iter([b.min]);
+    // Whether a piece at a position slides on straight out along one of
+    // the four directions (by index), studs clear, from there; or goes
+    // straight up ([`UP`]) or down ([`DOWN`]) out.
+    const UP: usize = 4;
+    const DOWN: usize = 5;
+    let mut runs: crate::keyhash::KeyMap<(Cell, usize), bool> = Default::default();
     let mut queue = VecDeque::from([b.min]);
     let (mut plo, mut phi) = (b.min, b.min);
     while let Some(p) = queue.pop_front() {
@@ -819,26 +825,60 @@ fn search_out(
         }
         plo = Cell::new(plo.x.min(p.x), plo.y.min(p.y), plo.z.min(p.z));
         phi = Cell::new(phi.x.max(p.x), phi.y.max(p.y), phi.z.max(p.z));
-        // A straight drop from above or press from below.
-        if !taken(&column(p, p.z + b.sz, hi.z + 1)) {
-            return Ok((p, Exit::Up));
-        }
-        if !taken(&column(p, lo.z, p.z)) {
-            return Ok((p, Exit::Down));
+        // A straight drop from above or press from below: the column over
+        // the piece clear to the top, or under it to the bottom (kept too,
+        // for the positions over and under on the same column).
+        for (key, dz) in [(UP, 1), (DOWN, -1)] {
+            let mut line = Vec::new();
+            let mut q = p;
+            let out = loop {
+                if let Some(&known) = runs.get(&(q, key)) {
+                    break known;
+                }
+                line.push(q);
+                let layer = if dz > 0 { q.z + b.sz } else { q.z - 1 };
+                if layer > hi.z || layer < lo.z {
+                    break true;
+                }
+                if taken(&column(q, layer, layer + 1)) {
+                    break false;
+                }
+                q = q.offset(0, 0, dz);
+            };
+            for q in line {
+                runs.insert((q, key), out);
+            }
+            if out {
+                return Ok((p, if dz > 0 { Exit::Up } else { Exit::Down }));
+            }
         }
         let clear_here = clear(p);
-        // Straight sideways out, studs clear all the way.
+        // Straight sideways out, studs clear all the way. Whether the way
+        // on from a position along a direction is clear is kept: the
+        // positions of one line share it (a search of a wide hollow
+        // otherwise walked every line again from each of its positions).
         if clear_here {
-            for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
-                let mut q = p;
-                loop {
+            for (d, (dx, dy)) in [(1, 0), (-1, 0), (0, 1), (0, -1)].into_iter().enumerate() {
+                let mut line = Vec::new();
+                let mut q = p.offset(dx, dy, 0);
+                let out = loop {
+                    if let Some(&known) = runs.get(&(q, d)) {
+                        break known;
+                    }
+                    line.push(q);
+                    if !free(q) || !clear(q) {
+                        break false;
+                    }
                     if outside(q) {
-                        return Ok((p, Exit::Side(dx, dy)));
+                        break true;
                     }
                     q = q.offset(dx, dy, 0);
-                    if !free(q) || !clear(q) {
-                        break;
-                    }
+                };
+                for q in line {
+                    runs.insert((q, d), out);
+                }
+                if out {
+                    return Ok((p, Exit::Side(dx, dy)));
                 }
             }
         }
@@ -939,6 +979,98 @@ mod tests {
     /// down past the build's lowest layer; a brick on top drops in from
     /// over the build's highest; a brick on the table between walls slides
     /// out of the end left open, its studs clear.
+    /// The search's shortcuts (the straight ways out, each kept for the
+    /// positions on its line) find a way out exactly where the moves
+    /// alone do: a plain search of the moves on random clutter.
+    #[test]
+    fn the_way_out_is_found_exactly_where_the_moves_alone_find_one() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let (lo, hi) = (Cell::new(0, 0, 0), Cell::new(7, 7, 5));
+        let (mut outs, mut stuck) = (0, 0);
+        for _ in 0..400 {
+            let density = rng.gen_range(0.2..0.7);
+            let mut cells = crate::geom::CellSet::default();
+            let grid = CellBox {
+                min: lo,
+                sx: 8,
+                sy: 8,
+                sz: 6,
+            };
+            for c in grid.cells() {
+                if rng.gen_bool(density) {
+                    cells.insert(c);
+                }
+            }
+            let b = CellBox {
+                min: Cell::new(
+                    rng.gen_range(0..7),
+                    rng.gen_range(0..7),
+                    rng.gen_range(0..6),
+                ),
+                sx: rng.gen_range(1..3),
+                sy: rng.gen_range(1..3),
+                sz: 1,
+            };
+            for c in b.cells() {
+                cells.remove(&c);
+            }
+            let taken = |x: &CellBox| x.cells().any(|c| cells.contains(&c));
+            let found = escape(&b, lo, hi, taken, usize::MAX) == Escape::Out;
+            // The moves alone: up and down where the box is free, sideways
+            // where its studs are clear here and there, until the box is
+            // outside the bounds.
+            let at = |p: Cell| CellBox { min: p, ..b };
+            let clear = |p: Cell| {
+                !taken(&CellBox {
+                    min: p.offset(0, 0, 1),
+                    ..b
+                }) && !taken(&CellBox {
+                    min: p.offset(0, 0, -1),
+                    ..b
+                })
+            };
+            let outside = |p: Cell| {
+                p.x + b.sx <= lo.x
+                    || p.x > hi.x
+                    || p.y + b.sy <= lo.y
+                    || p.y > hi.y
+                    || p.z + b.sz <= lo.z
+                    || p.z > hi.z
+            };
+            let mut seen = crate::geom::CellSet::from_iter([b.min]);
+            let mut queue = vec![b.min];
+            let mut plain = false;
+            while let Some(p) = queue.pop() {
+                if outside(p) {
+                    plain = true;
+                    break;
+                }
+                for (dx, dy, dz) in [
+                    (0, 0, 1),
+                    (0, 0, -1),
+                    (1, 0, 0),
+                    (-1, 0, 0),
+                    (0, 1, 0),
+                    (0, -1, 0),
+                ] {
+                    let q = p.offset(dx, dy, dz);
+                    let ok = !taken(&at(q)) && (dz != 0 || (clear(p) && clear(q)));
+                    if ok && seen.insert(q) {
+                        queue.push(q);
+                    }
+                }
+            }
+            assert_eq!(found, plain, "{b:?}");
+            if found {
+                outs += 1;
+            } else {
+                stuck += 1;
+            }
+        }
+        assert!(outs > 50 && stuck > 50, "{outs} out, {stuck} stuck");
+    }
+
     #[test]
     fn a_route_goes_on_past_the_bounds_of_what_may_come() {
         // Every piece of `asm` put in place.
