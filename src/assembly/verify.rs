@@ -762,6 +762,17 @@ pub(crate) fn route(
     Some(sweep)
 }
 
+/// Whether the piece in box `b`, moved to `p`, is wholly out of the
+/// bounding box `lo..=hi`: its way out is found.
+fn beyond(b: &CellBox, lo: Cell, hi: Cell, p: Cell) -> bool {
+    p.x + b.sx <= lo.x
+        || p.x > hi.x
+        || p.y + b.sy <= lo.y
+        || p.y > hi.y
+        || p.z + b.sz <= lo.z
+        || p.z > hi.z
+}
+
 /// [`escape`]'s search: the last position of the way out and how it
 /// leaves, or the inclusive corners of the positions reached. With
 /// `parents`, each position the search reached is recorded with the one
@@ -774,14 +785,7 @@ fn search_out(
     limit: usize,
     mut parents: Option<&mut HashMap<Cell, Cell>>,
 ) -> Result<(Cell, Exit), (Cell, Cell)> {
-    let outside = |p: Cell| {
-        p.x + b.sx <= lo.x
-            || p.x > hi.x
-            || p.y + b.sy <= lo.y
-            || p.y > hi.y
-            || p.z + b.sz <= lo.z
-            || p.z > hi.z
-    };
+    let outside = |p: Cell| beyond(b, lo, hi, p);
     // Corners of the search region: the bounding box grown by the piece's
     // size + 1 on every side. Every path out meets a goal before leaving it.
     let (rmin, rmax) = (
@@ -1030,14 +1034,7 @@ mod tests {
                     ..b
                 })
             };
-            let outside = |p: Cell| {
-                p.x + b.sx <= lo.x
-                    || p.x > hi.x
-                    || p.y + b.sy <= lo.y
-                    || p.y > hi.y
-                    || p.z + b.sz <= lo.z
-                    || p.z > hi.z
-            };
+            let outside = |p: Cell| beyond(&b, lo, hi, p);
             let mut seen = crate::geom::CellSet::from_iter([b.min]);
             let mut queue = vec![b.min];
             let mut plain = false;
