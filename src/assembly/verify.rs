@@ -773,6 +773,35 @@ fn beyond(b: &CellBox, lo: Cell, hi: Cell, p: Cell) -> bool {
         || p.z > hi.z
 }
 
+/// Whether the straight way from `start` (a position and the key of its
+/// direction) along `step` gets out: each position on the way answers
+/// for itself (`ends`: out, blocked, or go on) unless its answer is kept
+/// in `runs` already; every position walked keeps the answer, which is
+/// theirs too.
+fn along(
+    runs: &mut crate::keyhash::KeyMap<(Cell, usize), bool>,
+    (start, key): (Cell, usize),
+    (dx, dy, dz): (i32, i32, i32),
+    ends: impl Fn(Cell) -> Option<bool>,
+) -> bool {
+    let mut line = Vec::new();
+    let mut q = start;
+    let out = loop {
+        if let Some(&known) = runs.get(&(q, key)) {
+            break known;
+        }
+        line.push(q);
+        if let Some(end) = ends(q) {
+            break end;
+        }
+        q = q.offset(dx, dy, dz);
+    };
+    for q in line {
+        runs.insert((q, key), out);
+    }
+    out
+}
+
 /// [`escape`]'s search: the last position of the way out and how it
 /// leaves, or the inclusive corners of the positions reached. With
 /// `parents`, each position the search reached is recorded with the one
@@ -833,25 +862,14 @@ fn search_out(
         // the piece clear to the top, or under it to the bottom (kept too,
         // for the positions over and under on the same column).
         for (key, dz) in [(UP, 1), (DOWN, -1)] {
-            let mut line = Vec::new();
-            let mut q = p;
-            let out = loop {
-                if let Some(&known) = runs.get(&(q, key)) {
-                    break known;
-                }
-                line.push(q);
+            let out = along(&mut runs, (p, key), (0, 0, dz), |q| {
                 let layer = if dz > 0 { q.z + b.sz } else { q.z - 1 };
                 if layer > hi.z || layer < lo.z {
-                    break true;
+                    Some(true)
+                } else {
+                    taken(&column(q, layer, layer + 1)).then_some(false)
                 }
-                if taken(&column(q, layer, layer + 1)) {
-                    break false;
-                }
-                q = q.offset(0, 0, dz);
-            };
-            for q in line {
-                runs.insert((q, key), out);
-            }
+            });
             if out {
                 return Ok((p, if dz > 0 { Exit::Up } else { Exit::Down }));
             }
@@ -863,24 +881,14 @@ fn search_out(
         // otherwise walked every line again from each of its positions).
         if clear_here {
             for (d, (dx, dy)) in [(1, 0), (-1, 0), (0, 1), (0, -1)].into_iter().enumerate() {
-                let mut line = Vec::new();
-                let mut q = p.offset(dx, dy, 0);
-                let out = loop {
-                    if let Some(&known) = runs.get(&(q, d)) {
-                        break known;
-                    }
-                    line.push(q);
+                let first = p.offset(dx, dy, 0);
+                let out = along(&mut runs, (first, d), (dx, dy, 0), |q| {
                     if !free(q) || !clear(q) {
-                        break false;
+                        Some(false)
+                    } else {
+                        outside(q).then_some(true)
                     }
-                    if outside(q) {
-                        break true;
-                    }
-                    q = q.offset(dx, dy, 0);
-                };
-                for q in line {
-                    runs.insert((q, d), out);
-                }
+                });
                 if out {
                     return Ok((p, Exit::Side(dx, dy)));
                 }
@@ -979,10 +987,6 @@ mod tests {
         build(&pieces)
     }
 
-    /// The way in of a brick hung under a beam is the column under it, on
-    /// down past the build's lowest layer; a brick on top drops in from
-    /// over the build's highest; a brick on the table between walls slides
-    /// out of the end left open, its studs clear.
     /// The search's shortcuts (the straight ways out, each kept for the
     /// positions on its line) find a way out exactly where the moves
     /// alone do: a plain search of the moves on random clutter.
@@ -1068,6 +1072,10 @@ mod tests {
         assert!(outs > 50 && stuck > 50, "{outs} out, {stuck} stuck");
     }
 
+    /// The way in of a brick hung under a beam is the column under it, on
+    /// down past the build's lowest layer; a brick on top drops in from
+    /// over the build's highest; a brick on the table between walls slides
+    /// out of the end left open, its studs clear.
     #[test]
     fn a_route_goes_on_past_the_bounds_of_what_may_come() {
         // Every piece of `asm` put in place.

@@ -1007,6 +1007,8 @@ fn check_steps_in(
                     cert.place_to(end);
                     let mut late = Vec::new();
                     for job in &jobs {
+                        // A group off the ground is not asked: the
+                        // program names what falls.
                         let took = if job.grounded {
                             take_certificate(&mut cert, job, 0, &mut current, &mut exact)
                         } else {
@@ -1322,10 +1324,10 @@ fn take_certificate(
     Took::Stands
 }
 
-/// For a check that stops at its first failure and only says where
-/// (see [`analyze_steps_verdicts`]): group `job`, which the certifier's whole program
-/// has just proved to have no equilibrium, is marked failing without the
-/// program that would name what fails in it. The pieces its proof moves
+/// For a check that stops at its first failure and only says where (see
+/// [`analyze_steps_verdicts`]): group `job`, which the certifier's whole
+/// program has just proved to have no equilibrium, is marked failing
+/// without the program that would name what fails in it. The pieces its proof moves
 /// fall; its new pieces (from `begin` on) that stay still rest; the rest
 /// keep their stress of the step before. False, with nothing marked,
 /// where the proof moves none of them.
